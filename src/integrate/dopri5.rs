@@ -1,0 +1,385 @@
+//! Dormand–Prince 5(4) with PI step-size control and fourth-order dense output.
+//!
+//! Coefficients: J. R. Dormand & P. J. Prince, "A family of embedded Runge–Kutta formulae",
+//! J. Comput. Appl. Math. 6 (1980); dense-output coefficients and the PI controller as
+//! described in Hairer, Nørsett & Wanner, *Solving ODEs I* (2nd ed.), §II.4–II.6.
+
+use super::{OdeSystem, Stats, StepError, Stepper, Tolerances};
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+// Error weights: fifth-order minus embedded fourth-order solution.
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+// Dense output.
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+const SAFETY: f64 = 0.9;
+const FAC_MIN: f64 = 0.2; // the step shrinks by at most 5×
+const FAC_MAX: f64 = 10.0; // and grows by at most 10×
+const BETA: f64 = 0.04; // PI-control stabilisation
+const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
+
+/// Adaptive Dormand–Prince 5(4) ("dopri5", the method behind MATLAB's ode45 and SciPy's RK45).
+#[derive(Debug, Clone)]
+pub struct Dopri5 {
+    tol: Tolerances,
+    h_max: f64,
+    t: f64,
+    t_prev: f64,
+    h: f64,
+    y: Vec<f64>,
+    k: [Vec<f64>; 7],
+    y_new: Vec<f64>,
+    stage: Vec<f64>,
+    /// Dense-output coefficients of the last accepted step.
+    cont: [Vec<f64>; 5],
+    fac_old: f64,
+    first_step: bool,
+    stats: Stats,
+}
+
+impl Dopri5 {
+    /// Starts at `(t0, y0)`. `h_max` (s) caps the step (use `f64::INFINITY` for none);
+    /// `h0` is the first step, or `None` to choose it automatically.
+    pub fn new(t0: f64, y0: &[f64], tol: Tolerances, h_max: f64, h0: Option<f64>) -> Self {
+        let n = y0.len();
+        let z = || vec![0.0; n];
+        Dopri5 {
+            tol,
+            h_max,
+            t: t0,
+            t_prev: t0,
+            h: h0.unwrap_or(0.0),
+            y: y0.to_vec(),
+            k: [z(), z(), z(), z(), z(), z(), z()],
+            y_new: z(),
+            stage: z(),
+            cont: [z(), z(), z(), z(), z()],
+            fac_old: 1e-4,
+            first_step: true,
+            stats: Stats::default(),
+        }
+    }
+
+    /// Step size the controller proposes next (s).
+    pub fn proposed_step(&self) -> f64 {
+        self.h
+    }
+
+    fn scale(&self, y0: f64, y1: f64) -> f64 {
+        self.tol.atol + self.tol.rtol * y0.abs().max(y1.abs())
+    }
+
+    /// Initial step by the heuristic of Hairer, Nørsett & Wanner (§II.4, "starting step size").
+    fn initial_step<S: OdeSystem + ?Sized>(&mut self, sys: &S, span: f64) -> f64 {
+        let n = self.y.len() as f64;
+        let (mut d0, mut d1) = (0.0, 0.0);
+        for i in 0..self.y.len() {
+            let sc = self.scale(self.y[i], self.y[i]);
+            d0 += (self.y[i] / sc).powi(2);
+            d1 += (self.k[0][i] / sc).powi(2);
+        }
+        let (d0, d1) = ((d0 / n).sqrt(), (d1 / n).sqrt());
+        let mut h0 = if d0 < 1e-10 || d1 < 1e-10 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
+        h0 = h0.min(self.h_max).min(span);
+        for i in 0..self.y.len() {
+            self.stage[i] = self.y[i] + h0 * self.k[0][i];
+        }
+        sys.rhs(self.t + h0, &self.stage, &mut self.k[1]);
+        self.stats.rhs_evaluations += 1;
+        let mut d2 = 0.0;
+        for i in 0..self.y.len() {
+            let sc = self.scale(self.y[i], self.y[i]);
+            d2 += ((self.k[1][i] - self.k[0][i]) / sc).powi(2);
+        }
+        let d2 = (d2 / n).sqrt() / h0;
+        let h1 = if d1.max(d2) <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 5.0)
+        };
+        (100.0 * h0).min(h1).min(self.h_max).min(span)
+    }
+
+    /// Evaluates stages 2–7 for step `h` from `(t, y)` with `k[0] = f(t, y)`; returns the
+    /// scaled RMS error estimate (non-finite if the stages were).
+    fn attempt<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> f64 {
+        let t = self.t;
+        let n = self.y.len();
+        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
+        let (y, s) = (&self.y, &mut self.stage);
+        for i in 0..n {
+            s[i] = y[i] + h * A21 * k1[i];
+        }
+        sys.rhs(t + C2 * h, s, k2);
+        for i in 0..n {
+            s[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
+        }
+        sys.rhs(t + C3 * h, s, k3);
+        for i in 0..n {
+            s[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
+        }
+        sys.rhs(t + C4 * h, s, k4);
+        for i in 0..n {
+            s[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
+        }
+        sys.rhs(t + C5 * h, s, k5);
+        for i in 0..n {
+            s[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
+        }
+        sys.rhs(t + h, s, k6);
+        let y_new = &mut self.y_new;
+        for i in 0..n {
+            y_new[i] =
+                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
+        }
+        sys.rhs(t + h, y_new, k7);
+        self.stats.rhs_evaluations += 6;
+        let mut err = 0.0;
+        for i in 0..n {
+            let e =
+                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
+            let sc = self.tol.atol + self.tol.rtol * y[i].abs().max(y_new[i].abs());
+            err += (e / sc).powi(2);
+        }
+        (err / n as f64).sqrt()
+    }
+
+    fn store_dense_output(&mut self, h: f64) {
+        let [k1, _, k3, k4, k5, k6, k7] = &self.k;
+        let [c1, c2, c3, c4, c5] = &mut self.cont;
+        for i in 0..self.y.len() {
+            let dy = self.y_new[i] - self.y[i];
+            let bspl = h * k1[i] - dy;
+            c1[i] = self.y[i];
+            c2[i] = dy;
+            c3[i] = bspl;
+            c4[i] = dy - h * k7[i] - bspl;
+            c5[i] =
+                h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
+        }
+    }
+}
+
+impl Stepper for Dopri5 {
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError> {
+        let span = t_end - self.t;
+        if self.first_step {
+            sys.rhs(self.t, &self.y, &mut self.k[0]);
+            self.stats.rhs_evaluations += 1;
+            if !self.k[0].iter().all(|v| v.is_finite()) {
+                return Err(StepError::NonFiniteDerivative { t: self.t });
+            }
+            if self.h <= 0.0 {
+                self.h = self.initial_step(sys, span);
+            }
+            self.first_step = false;
+        }
+        let mut rejected_in_a_row = 0;
+        let mut saw_non_finite = false;
+        loop {
+            let mut h = self.h.min(self.h_max);
+            // Land exactly on t_end rather than leave a sliver of a step.
+            let last = h >= span * (1.0 - 1e-12);
+            if last {
+                h = span;
+            }
+            if h.abs() <= 16.0 * f64::EPSILON * self.t.abs().max(1e-300) {
+                return Err(if saw_non_finite {
+                    StepError::NonFiniteDerivative { t: self.t }
+                } else {
+                    StepError::StepSizeUnderflow { t: self.t, h }
+                });
+            }
+            let err = self.attempt(sys, h);
+            if !err.is_finite() {
+                saw_non_finite = true;
+                self.stats.rejected_steps += 1;
+                self.h = 0.1 * h;
+                rejected_in_a_row += 1;
+                if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
+                    return Err(StepError::NonFiniteDerivative { t: self.t });
+                }
+                continue;
+            }
+            let fac11 = err.powf(0.2 - 0.75 * BETA);
+            if err <= 1.0 {
+                // Accepted: PI controller for the next step.
+                let mut fac = fac11 / self.fac_old.powf(BETA);
+                fac = (fac / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                let mut h_new = h / fac;
+                if rejected_in_a_row > 0 {
+                    h_new = h_new.min(h);
+                }
+                self.fac_old = err.max(1e-4);
+                self.store_dense_output(h);
+                std::mem::swap(&mut self.y, &mut self.y_new);
+                // FSAL: the last stage is f at the new point.
+                self.k.swap(0, 6);
+                self.t_prev = self.t;
+                self.t = if last { t_end } else { self.t + h };
+                self.stats.steps += 1;
+                // Keep the proposal for the next call; a shortened last step does not shrink it.
+                self.h = if last { self.h.max(h_new) } else { h_new };
+                return Ok(self.t);
+            }
+            self.stats.rejected_steps += 1;
+            rejected_in_a_row += 1;
+            if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
+                return Err(StepError::StepSizeUnderflow { t: self.t, h });
+            }
+            self.h = h / (1.0 / FAC_MIN).min(fac11 / SAFETY);
+        }
+    }
+
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let h = self.t - self.t_prev;
+        if h == 0.0 {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        let th = (t - self.t_prev) / h;
+        let th1 = 1.0 - th;
+        let [c1, c2, c3, c4, c5] = &self.cont;
+        for i in 0..out.len() {
+            out[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y' = λ y, exact solution e^{λt}.
+    struct Exponential(f64);
+    impl OdeSystem for Exponential {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+            dydt[0] = self.0 * y[0];
+        }
+    }
+
+    /// Harmonic oscillator y'' = −y: (cos t, −sin t).
+    struct Oscillator;
+    impl OdeSystem for Oscillator {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+            dydt[0] = y[1];
+            dydt[1] = -y[0];
+        }
+    }
+
+    #[test]
+    fn meets_tolerance_on_exponential() {
+        let tol = Tolerances {
+            rtol: 1e-10,
+            atol: 1e-12,
+        };
+        let mut s = Dopri5::new(0.0, &[1.0], tol, f64::INFINITY, None);
+        while s.t() < 5.0 {
+            s.step(&Exponential(-0.7), 5.0).unwrap();
+        }
+        let exact = (-0.7f64 * 5.0).exp();
+        let y = s.y()[0];
+        assert!((y - exact).abs() < 1e-9 * exact, "{y} vs {exact}");
+        assert_eq!(s.t(), 5.0);
+    }
+
+    #[test]
+    fn dense_output_is_fourth_order_accurate_inside_steps() {
+        let tol = Tolerances {
+            rtol: 1e-9,
+            atol: 1e-9,
+        };
+        let mut s = Dopri5::new(0.0, &[1.0, 0.0], tol, f64::INFINITY, None);
+        let mut worst: f64 = 0.0;
+        let mut out = [0.0; 2];
+        while s.t() < 20.0 {
+            s.step(&Oscillator, 20.0).unwrap();
+            let (a, b) = (s.t_prev(), s.t());
+            for j in 1..10 {
+                let t = a + (b - a) * j as f64 / 10.0;
+                s.interpolate(t, &mut out);
+                worst = worst.max((out[0] - t.cos()).abs().max((out[1] + t.sin()).abs()));
+            }
+        }
+        assert!(worst < 1e-7, "dense output error {worst}");
+    }
+
+    #[test]
+    fn convergence_order_is_five() {
+        // Fixed steps (h_max = h and loose tolerance) so the error is the method's alone.
+        let err_at = |h: f64| {
+            let tol = Tolerances {
+                rtol: 1.0,
+                atol: 1.0,
+            };
+            let mut s = Dopri5::new(0.0, &[1.0, 0.0], tol, h, Some(h));
+            while s.t() < 10.0 {
+                s.step(&Oscillator, 10.0).unwrap();
+            }
+            let y = s.y();
+            ((y[0] - 10f64.cos()).powi(2) + (y[1] + 10f64.sin()).powi(2)).sqrt()
+        };
+        let (e1, e2) = (err_at(0.1), err_at(0.05));
+        let order = (e1 / e2).log2();
+        assert!((order - 5.0).abs() < 0.3, "measured order {order}");
+    }
+}

@@ -1,0 +1,96 @@
+//! Numerical integrators behind one interface.
+//!
+//! Every method implements [`Stepper`]: it owns the current `(t, y)`, advances by one accepted
+//! step, and can interpolate anywhere inside its last step (dense output). The simulation
+//! driver samples the output grid and locates events on that interpolant, so a new method
+//! (fixed-step, adaptive, implicit, a closed-form propagator) only has to provide these few
+//! operations.
+
+mod dopri5;
+mod rk4;
+
+pub use dopri5::Dopri5;
+pub use rk4::Rk4;
+
+use std::fmt;
+
+/// A first-order ODE system `dy/dt = f(t, y)` of fixed dimension.
+pub trait OdeSystem {
+    /// Number of state components.
+    fn dim(&self) -> usize;
+    /// Writes `f(t, y)` into `dydt` (both of length [`OdeSystem::dim`]).
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
+}
+
+/// Work counters of a run, reported in summaries (so accuracy can be charted against cost).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected steps (adaptive methods).
+    pub rejected_steps: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evaluations: u64,
+}
+
+/// Why a step could not be taken.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepError {
+    /// The adaptive controller asked for a step below the resolution of `t`.
+    StepSizeUnderflow {
+        /// Time at which the step failed (s).
+        t: f64,
+        /// Step size that was requested (s).
+        h: f64,
+    },
+    /// The right-hand side returned a non-finite value.
+    NonFiniteDerivative {
+        /// Time at which it happened (s).
+        t: f64,
+    },
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepError::StepSizeUnderflow { t, h } => write!(
+                f,
+                "step size underflow at t = {t} s (h = {h:e} s): the tolerance cannot be met; \
+                 loosen rtol/atol or check the model for a singularity"
+            ),
+            StepError::NonFiniteDerivative { t } => write!(
+                f,
+                "the right-hand side became non-finite at t = {t} s: the state left the domain \
+                 of the model"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for StepError {}
+
+/// One integration method advancing a state in time.
+pub trait Stepper {
+    /// Current time (s).
+    fn t(&self) -> f64;
+    /// Current state.
+    fn y(&self) -> &[f64];
+    /// Takes one accepted step, never past `t_end`. Returns the time reached.
+    fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError>;
+    /// Start time of the last accepted step (equals `t()` before the first step).
+    fn t_prev(&self) -> f64;
+    /// Interpolates the state at `t` within the last accepted step `[t_prev, t]`.
+    fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// Work counters so far.
+    fn stats(&self) -> Stats;
+}
+
+/// Tolerances of an adaptive method: the local error estimate of component `i` is kept below
+/// `atol + rtol·|y_i|`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// Relative tolerance (dimensionless).
+    pub rtol: f64,
+    /// Absolute tolerance (units of the state).
+    pub atol: f64,
+}
