@@ -1,0 +1,135 @@
+//! Quantities derived from a state at one instant: what every logged sample knows.
+
+use super::{HubState, Spacecraft};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// Derived quantities at one instant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Observation {
+    /// Simulation time (s).
+    pub t: f64,
+    /// Body rates (rad/s, body frame).
+    pub omega: Vector3<f64>,
+    /// Attitude, body → inertial, normalised from the integrated quaternion.
+    pub attitude: UnitQuaternion<f64>,
+    /// `|q| − 1` of the integrated quaternion (a measure of integration error).
+    pub q_norm_error: f64,
+    /// Total angular momentum about the system centre of mass, body frame (N m s).
+    pub h_body: Vector3<f64>,
+    /// The same in the inertial frame (N m s); constant for a free system.
+    pub h_inertial: Vector3<f64>,
+    /// `|H|` (N m s).
+    pub h_norm: f64,
+    /// Rotational kinetic energy (J).
+    pub kinetic_energy: f64,
+    /// Angle between the scenario's spin axis and H (rad).
+    pub nutation_angle: f64,
+    /// Angle between ω and each principal axis, in principal order (rad, in [0, π]).
+    pub angles_to_principal: [f64; 3],
+}
+
+/// Angle between two vectors (rad), accurate for small and near-π angles alike.
+pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// The conserved quantities only: what drift tracking needs at every step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Invariants {
+    /// Angular momentum, body frame (N m s).
+    pub h_body: Vector3<f64>,
+    /// Angular momentum, inertial frame (N m s).
+    pub h_inertial: Vector3<f64>,
+    /// Kinetic energy (J).
+    pub kinetic_energy: f64,
+    /// `|q| − 1`.
+    pub q_norm_error: f64,
+}
+
+pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, UnitQuaternion<f64>) {
+    let omega = Vector3::new(y[0], y[1], y[2]);
+    let q_raw = Quaternion::new(y[3], y[4], y[5], y[6]);
+    let q_norm = q_raw.norm();
+    let attitude = UnitQuaternion::new_unchecked(q_raw / q_norm);
+    let mut h_body = sc.hub.inertia * omega;
+    let mut kinetic_energy = 0.5 * omega.dot(&(sc.hub.inertia * omega));
+    if !sc.effectors().is_empty() {
+        let hub = HubState {
+            t,
+            omega,
+            attitude: &y[3..7],
+        };
+        for (i, e) in sc.effectors().iter().enumerate() {
+            let x = sc.effector_states(i, y);
+            h_body += e.angular_momentum(&hub, x);
+            kinetic_energy += e.kinetic_energy(&hub, x);
+        }
+    }
+    let h_inertial = attitude * h_body;
+    let inv = Invariants {
+        h_body,
+        h_inertial,
+        kinetic_energy,
+        q_norm_error: q_norm - 1.0,
+    };
+    (inv, attitude)
+}
+
+pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64]) -> Observation {
+    let (inv, attitude) = invariants(sc, t, y);
+    let omega = Vector3::new(y[0], y[1], y[2]);
+    let Invariants {
+        h_body,
+        h_inertial,
+        kinetic_energy,
+        q_norm_error,
+    } = inv;
+    let axes = &sc.hub.principal_axes;
+    let angles_to_principal = [0, 1, 2].map(|c| angle_between(&omega, &axes.column(c).into()));
+    Observation {
+        t,
+        omega,
+        attitude,
+        q_norm_error,
+        h_body,
+        h_inertial,
+        h_norm: h_body.norm(),
+        kinetic_energy,
+        nutation_angle: angle_between(&sc.spin_axis, &h_body),
+        angles_to_principal,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::RigidBody;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn momentum_energy_and_angles_of_a_known_state() {
+        let sc = Spacecraft::new(
+            RigidBody::from_principal([1.0, 2.0, 3.0]).unwrap(),
+            Vector3::z(),
+        );
+        // Rotated by 90° about z: body x is inertial y.
+        let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::FRAC_PI_2);
+        let y = sc.initial_state(&Vector3::new(1.0, 0.0, 1.0), &q);
+        let o = sc.observe(0.0, &y);
+        assert_relative_eq!(o.h_body, Vector3::new(1.0, 0.0, 3.0), epsilon = 1e-15);
+        assert_relative_eq!(o.h_inertial, Vector3::new(0.0, 1.0, 3.0), epsilon = 1e-15);
+        assert_relative_eq!(o.kinetic_energy, 0.5 * (1.0 + 3.0), epsilon = 1e-15);
+        assert_relative_eq!(o.nutation_angle, (1.0f64 / 3.0).atan(), epsilon = 1e-15);
+        let quarter = std::f64::consts::FRAC_PI_4;
+        assert_relative_eq!(o.angles_to_principal[0], quarter, epsilon = 1e-15);
+        assert_relative_eq!(o.angles_to_principal[1], 2.0 * quarter, epsilon = 1e-15);
+        assert_relative_eq!(o.angles_to_principal[2], quarter, epsilon = 1e-15);
+    }
+
+    #[test]
+    fn small_angles_keep_their_digits() {
+        let a = Vector3::new(1.0, 0.0, 0.0);
+        let b = Vector3::new(1.0, 1e-12, 0.0);
+        assert_relative_eq!(angle_between(&a, &b), 1e-12, max_relative = 1e-12);
+    }
+}
