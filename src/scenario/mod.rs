@@ -1,0 +1,920 @@
+//! The scenario file: the user-facing YAML contract (documented in `docs/scenarios.md`).
+//!
+//! Loading has two phases: serde turns the text into [`ScenarioFile`] (syntax, unknown keys and
+//! types are reported by the YAML layer with their line and column), then [`ScenarioFile::validate`]
+//! checks physics and ranges, using the spans kept on every checked field, and produces a
+//! [`Scenario`] ready to run.
+
+mod error;
+mod time;
+
+pub use error::{ScenarioError, field_path_at, nearest};
+pub use time::{format_epoch, parse_epoch};
+
+use crate::model::{RigidBody, Spacecraft};
+use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use serde::Deserialize;
+use serde_saphyr::Spanned;
+use std::path::{Path, PathBuf};
+
+/// Largest number of output samples a run may request (duration × rate); beyond it the log
+/// would be tens of gigabytes.
+pub const MAX_SAMPLES: f64 = 5e7;
+/// Largest scenario file accepted (bytes).
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+/// Default epoch of sim time 0: J2000, 2000-01-01T12:00:00Z.
+pub const DEFAULT_EPOCH: &str = "2000-01-01T12:00:00Z";
+
+/// The scenario as written in YAML.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    /// Short identifier, used for the default log name.
+    pub name: Spanned<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// UTC date and time of sim time 0 (RFC 3339, e.g. `2000-01-01T12:00:00Z`).
+    #[serde(default)]
+    pub epoch: Option<Spanned<String>>,
+    /// The rigid hub.
+    pub body: BodySpec,
+    /// Initial state.
+    pub initial: InitialSpec,
+    /// Simulated time span (s).
+    pub duration: Spanned<f64>,
+    /// Integration method and its settings.
+    #[serde(default)]
+    pub integrator: Option<IntegratorSpec>,
+    /// Logging.
+    #[serde(default)]
+    pub output: Option<OutputSpec>,
+    /// Conditions that end the run, located in time.
+    #[serde(default)]
+    pub stop: Vec<Spanned<ConditionSpec>>,
+    /// Conditions recorded every time they become true, without stopping.
+    #[serde(default)]
+    pub events: Vec<Spanned<ConditionSpec>>,
+}
+
+/// `body:` mass properties and display.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Full inertia tensor about the centre of mass, body axes (kg m², rows).
+    #[serde(default)]
+    pub inertia: Option<Spanned<[[f64; 3]; 3]>>,
+    /// Principal moments along body x, y, z (kg m²), instead of `inertia`.
+    #[serde(default)]
+    pub principal: Option<Spanned<[f64; 3]>>,
+    /// Body axis whose angle to H is reported as the nutation angle.
+    #[serde(default)]
+    pub spin_axis: Option<Spanned<[f64; 3]>>,
+    /// Shape drawn in viewers (default: a box with the proportions of the inertia).
+    #[serde(default)]
+    pub shape: Option<Spanned<ShapeSpec>>,
+}
+
+/// A shape for the 3D view, in body axes, centred on the centre of mass.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum ShapeSpec {
+    /// Box with side lengths along body x, y, z (m).
+    Box {
+        /// Side lengths (m).
+        size: [f64; 3],
+    },
+    /// Cylinder with its axis along a body axis.
+    Cylinder {
+        /// Radius (m).
+        radius: f64,
+        /// Length (m).
+        length: f64,
+        /// Axis direction in body axes (default z).
+        #[serde(default)]
+        axis: Option<[f64; 3]>,
+    },
+}
+
+/// `initial:` state at sim time 0.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// Body rates (rad/s).
+    #[serde(default)]
+    pub omega: Option<Spanned<[f64; 3]>>,
+    /// Body rates (rev/min), instead of `omega`.
+    #[serde(default)]
+    pub omega_rpm: Option<Spanned<[f64; 3]>>,
+    /// Attitude, body → inertial (default identity).
+    #[serde(default)]
+    pub attitude: Option<Spanned<QuaternionSpec>>,
+}
+
+/// A quaternion by named components (scalar `w`).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuaternionSpec {
+    /// Scalar part.
+    pub w: f64,
+    /// Vector part, x.
+    pub x: f64,
+    /// Vector part, y.
+    pub y: f64,
+    /// Vector part, z.
+    pub z: f64,
+}
+
+/// `integrator:` method and settings.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSpec {
+    /// `rk4`, `dopri5` or `exact`.
+    #[serde(default)]
+    pub method: Option<Spanned<String>>,
+    /// Fixed step (s), for `rk4`.
+    #[serde(default)]
+    pub dt: Option<Spanned<f64>>,
+    /// Relative tolerance, for adaptive methods.
+    #[serde(default)]
+    pub rtol: Option<Spanned<f64>>,
+    /// Absolute tolerance, for adaptive methods.
+    #[serde(default)]
+    pub atol: Option<Spanned<f64>>,
+    /// Largest step (s), for adaptive methods.
+    #[serde(default)]
+    pub max_step: Option<Spanned<f64>>,
+}
+
+/// `output:` sampling and log file.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Samples per second of sim time (Hz).
+    #[serde(default)]
+    pub rate: Option<Spanned<f64>>,
+    /// MCAP path (relative paths are relative to the working directory).
+    #[serde(default)]
+    pub mcap: Option<Spanned<String>>,
+    /// Largest rate of `/scene` updates (Hz, default 10): the body is drawn at every `/tf`
+    /// sample through its frame; only the ω and H arrows need scene updates.
+    #[serde(default)]
+    pub scene_rate: Option<Spanned<f64>>,
+    /// Chunk compression: `lz4` (default: fast), `zstd` (smaller, ~2× slower to write) or
+    /// `none` (fastest, largest).
+    #[serde(default)]
+    pub compression: Option<Compression>,
+}
+
+/// MCAP chunk compression.
+#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Compression {
+    /// LZ4 frames: fast, moderate size.
+    #[default]
+    Lz4,
+    /// Zstandard: smaller files, slower to write.
+    Zstd,
+    /// Uncompressed chunks.
+    None,
+}
+
+/// A condition on a logged quantity, e.g. `{nutation_angle_deg: {above: 89.0}}`.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum ConditionSpec {
+    /// Nutation angle of the spin axis relative to H (degrees).
+    NutationAngleDeg(ThresholdSpec),
+    /// Angle between ω and the minimum-inertia principal axis (degrees).
+    AngleToPrincipal1Deg(ThresholdSpec),
+    /// Angle between ω and the intermediate principal axis (degrees).
+    AngleToPrincipal2Deg(ThresholdSpec),
+    /// Angle between ω and the maximum-inertia principal axis (degrees).
+    AngleToPrincipal3Deg(ThresholdSpec),
+    /// Body rate about x (rad/s).
+    OmegaX(ThresholdSpec),
+    /// Body rate about y (rad/s).
+    OmegaY(ThresholdSpec),
+    /// Body rate about z (rad/s).
+    OmegaZ(ThresholdSpec),
+    /// Rotational kinetic energy (J).
+    KineticEnergy(ThresholdSpec),
+}
+
+/// `{above: X}` or `{below: X}`: the condition holds while the quantity is above (below) X.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ThresholdSpec {
+    /// Holds while the quantity is greater than this.
+    #[serde(default)]
+    pub above: Option<f64>,
+    /// Holds while the quantity is less than this.
+    #[serde(default)]
+    pub below: Option<f64>,
+}
+
+/// A quantity events can watch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// Nutation angle (degrees).
+    NutationAngleDeg,
+    /// Angle between ω and principal axis 1, 2 or 3 (degrees); the index is 0-based.
+    AngleToPrincipalDeg(usize),
+    /// Body rate component 0, 1 or 2 (rad/s).
+    Omega(usize),
+    /// Kinetic energy (J).
+    KineticEnergy,
+}
+
+impl Quantity {
+    /// The YAML key naming it.
+    pub fn key(&self) -> &'static str {
+        match self {
+            Quantity::NutationAngleDeg => "nutation_angle_deg",
+            Quantity::AngleToPrincipalDeg(0) => "angle_to_principal_1_deg",
+            Quantity::AngleToPrincipalDeg(1) => "angle_to_principal_2_deg",
+            Quantity::AngleToPrincipalDeg(_) => "angle_to_principal_3_deg",
+            Quantity::Omega(0) => "omega_x",
+            Quantity::Omega(1) => "omega_y",
+            Quantity::Omega(_) => "omega_z",
+            Quantity::KineticEnergy => "kinetic_energy",
+        }
+    }
+
+    /// Its value in an observation.
+    pub fn value(&self, o: &crate::model::Observation) -> f64 {
+        match *self {
+            Quantity::NutationAngleDeg => o.nutation_angle.to_degrees(),
+            Quantity::AngleToPrincipalDeg(i) => o.angles_to_principal[i].to_degrees(),
+            Quantity::Omega(i) => o.omega[i],
+            Quantity::KineticEnergy => o.kinetic_energy,
+        }
+    }
+}
+
+/// A validated condition: holds while `sign · (quantity − threshold) > 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Condition {
+    /// What is watched.
+    pub quantity: Quantity,
+    /// The threshold, in the quantity's unit.
+    pub threshold: f64,
+    /// `true` for `above`, `false` for `below`.
+    pub above: bool,
+}
+
+impl Condition {
+    /// Signed distance from the threshold: positive while the condition holds.
+    pub fn margin(&self, o: &crate::model::Observation) -> f64 {
+        let d = self.quantity.value(o) - self.threshold;
+        if self.above { d } else { -d }
+    }
+
+    /// Human-readable form, e.g. `nutation_angle_deg above 89`.
+    pub fn describe(&self) -> String {
+        let dir = if self.above { "above" } else { "below" };
+        format!("{} {dir} {}", self.quantity.key(), self.threshold)
+    }
+}
+
+/// The integration method and its settings, validated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Classic RK4 with fixed step `dt` (s).
+    Rk4 {
+        /// Step (s).
+        dt: f64,
+    },
+    /// Adaptive Dormand–Prince 5(4).
+    Dopri5 {
+        /// Relative tolerance.
+        rtol: f64,
+        /// Absolute tolerance.
+        atol: f64,
+        /// Largest step (s).
+        max_step: f64,
+    },
+    /// Closed-form torque-free solution.
+    Exact,
+}
+
+impl Method {
+    /// Names accepted in YAML and on the command line.
+    pub const NAMES: [&'static str; 3] = ["rk4", "dopri5", "exact"];
+
+    /// Its name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Rk4 { .. } => "rk4",
+            Method::Dopri5 { .. } => "dopri5",
+            Method::Exact => "exact",
+        }
+    }
+
+    /// Name and settings, e.g. `dopri5 (rtol 1e-10, atol 1e-12)`.
+    pub fn describe(&self) -> String {
+        match self {
+            Method::Rk4 { dt } => format!("rk4 (dt {dt:e} s)"),
+            Method::Dopri5 {
+                rtol,
+                atol,
+                max_step,
+            } => {
+                let cap = if max_step.is_finite() {
+                    format!(", max_step {max_step:e} s")
+                } else {
+                    String::new()
+                };
+                format!("dopri5 (rtol {rtol:e}, atol {atol:e}{cap})")
+            }
+            Method::Exact => "exact (closed-form torque-free solution)".into(),
+        }
+    }
+}
+
+/// Shape drawn in viewers, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// Box with side lengths (m) along the columns of `axes` (body coordinates).
+    Box {
+        /// Side lengths (m).
+        size: Vector3<f64>,
+        /// Orientation of the box in the body frame.
+        orientation: UnitQuaternion<f64>,
+    },
+    /// Cylinder whose axis is the local z of `orientation`.
+    Cylinder {
+        /// Radius (m).
+        radius: f64,
+        /// Length (m).
+        length: f64,
+        /// Rotation taking z to the cylinder axis, in the body frame.
+        orientation: UnitQuaternion<f64>,
+    },
+}
+
+/// A validated scenario, ready to run.
+#[derive(Debug)]
+pub struct Scenario {
+    /// Where it was read from.
+    pub path: PathBuf,
+    /// The YAML text as read (attached to logs).
+    pub source: String,
+    /// `name:`.
+    pub name: String,
+    /// `description:`.
+    pub description: String,
+    /// Sim time 0 as Unix time (ns).
+    pub epoch_unix_ns: u64,
+    /// The spacecraft (hub and effectors).
+    pub spacecraft: Spacecraft,
+    /// Initial body rates (rad/s).
+    pub omega0: Vector3<f64>,
+    /// Initial attitude, body → inertial.
+    pub attitude0: UnitQuaternion<f64>,
+    /// Simulated time span (s).
+    pub duration: f64,
+    /// Integration method.
+    pub method: Method,
+    /// Samples per second of sim time (Hz).
+    pub output_rate: f64,
+    /// Where the MCAP log goes.
+    pub mcap_path: PathBuf,
+    /// Largest rate of `/scene` updates (Hz).
+    pub scene_rate: f64,
+    /// MCAP chunk compression.
+    pub compression: Compression,
+    /// Conditions that end the run.
+    pub stop: Vec<Condition>,
+    /// Conditions that are recorded.
+    pub events: Vec<Condition>,
+    /// Shape for viewers.
+    pub shape: Shape,
+}
+
+/// Overrides from the command line, applied before validation.
+#[derive(Debug, Clone, Default)]
+pub struct Overrides {
+    /// `--method`.
+    pub method: Option<String>,
+    /// `--dt` (s).
+    pub dt: Option<f64>,
+    /// `--rtol`.
+    pub rtol: Option<f64>,
+    /// `--atol`.
+    pub atol: Option<f64>,
+    /// `--duration` (s).
+    pub duration: Option<f64>,
+    /// `--out`.
+    pub mcap: Option<PathBuf>,
+}
+
+/// Reads and validates a scenario file.
+pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioError> {
+    let meta = std::fs::metadata(path)
+        .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(ScenarioError::whole_file(
+            path,
+            format!(
+                "the file is {} bytes; a scenario must be at most {MAX_FILE_BYTES} bytes",
+                meta.len()
+            ),
+        ));
+    }
+    let bytes = std::fs::read(path)
+        .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
+    let source = String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        let before = &e.as_bytes()[..offset];
+        let line = before.iter().filter(|&&b| b == b'\n').count() as u32 + 1;
+        let column = (offset
+            - before
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |p| p + 1)) as u32
+            + 1;
+        ScenarioError::at(
+            path,
+            Some((line, column)),
+            "",
+            "the file is not valid UTF-8 text (expected a YAML file)",
+        )
+    })?;
+    parse(path, source, overrides)
+}
+
+/// Parses and validates scenario text (`path` is used in messages and for nothing else).
+pub fn parse(
+    path: &Path,
+    source: String,
+    overrides: &Overrides,
+) -> Result<Scenario, ScenarioError> {
+    let file: ScenarioFile = match serde_saphyr::from_str(&source) {
+        Ok(f) => f,
+        Err(e) => return Err(yaml_error(path, &source, &e)),
+    };
+    file.validate(path, source, overrides)
+}
+
+/// Turns a YAML-layer error into a located [`ScenarioError`] with a suggestion for misspelt keys.
+fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioError {
+    let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+    let rendered = e.without_snippet().to_string();
+    let mut message = rendered.lines().next().unwrap_or("").trim().to_string();
+    // Drop the library's own "error: line L column C:" prefix; we print the location ourselves.
+    if let Some(rest) = message.strip_prefix("error: ") {
+        message = rest.to_string();
+    }
+    if message.starts_with("line ")
+        && let Some((_, rest)) = message.split_once(": ")
+    {
+        message = rest.to_string();
+    }
+    if message.is_empty() {
+        message = "invalid YAML".into();
+    }
+    // "unknown field `x`, expected one of a, b" → suggest the nearest valid name.
+    if message.starts_with("unknown")
+        && let Some(unknown) = message.split('`').nth(1)
+        && let Some((_, list)) = message.split_once("expected one of ")
+    {
+        let valid: Vec<&str> = list
+            .split(',')
+            .map(|s| s.trim().trim_matches('`'))
+            .collect();
+        if let Some(best) = nearest(unknown, valid.iter().copied()) {
+            message = format!("{message}; did you mean `{best}`?");
+        }
+    }
+    let field = location
+        .map(|(l, c)| field_path_at(source, l, c))
+        .unwrap_or_default();
+    ScenarioError::at(path, location, field, message)
+}
+
+fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
+    Some((s.referenced.line() as u32, s.referenced.column() as u32))
+}
+
+fn finite3(v: &[f64; 3]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+impl ScenarioFile {
+    /// Checks physics and ranges and builds the runnable [`Scenario`].
+    pub fn validate(
+        self,
+        path: &Path,
+        source: String,
+        ov: &Overrides,
+    ) -> Result<Scenario, ScenarioError> {
+        let err = |l: Option<(u32, u32)>, field: &str, msg: String| {
+            ScenarioError::at(path, l, field, msg)
+        };
+        let name = self.name.value.trim().to_string();
+        if name.is_empty() {
+            return Err(err(
+                loc(&self.name),
+                "name",
+                "expected a non-empty name".into(),
+            ));
+        }
+
+        // Body.
+        let (inertia, inertia_loc, inertia_field) = match (&self.body.inertia, &self.body.principal)
+        {
+            (Some(_), Some(p)) => {
+                return Err(err(
+                    loc(p),
+                    "body.principal",
+                    "give either `inertia` or `principal`, not both".into(),
+                ));
+            }
+            (Some(i), None) => (
+                Matrix3::from_row_slice(&i.value.concat()),
+                loc(i),
+                "body.inertia",
+            ),
+            (None, Some(p)) => (
+                Matrix3::from_diagonal(&Vector3::from(p.value)),
+                loc(p),
+                "body.principal",
+            ),
+            (None, None) => {
+                return Err(err(
+                    None,
+                    "body",
+                    "missing the mass properties: expected `inertia: [[..],[..],[..]]` \
+                     (kg m²) or `principal: [I1, I2, I3]`"
+                        .into(),
+                ));
+            }
+        };
+        let hub = RigidBody::new(inertia).map_err(|e| {
+            err(
+                inertia_loc,
+                inertia_field,
+                format!("not a physical inertia tensor: {e}"),
+            )
+        })?;
+
+        // Initial state.
+        let omega0 = match (&self.initial.omega, &self.initial.omega_rpm) {
+            (Some(_), Some(r)) => {
+                return Err(err(
+                    loc(r),
+                    "initial.omega_rpm",
+                    "give either `omega` (rad/s) or `omega_rpm`, not both".into(),
+                ));
+            }
+            (Some(w), None) => {
+                if !finite3(&w.value) {
+                    return Err(err(
+                        loc(w),
+                        "initial.omega",
+                        "expected three finite numbers (rad/s)".into(),
+                    ));
+                }
+                Vector3::from(w.value)
+            }
+            (None, Some(r)) => {
+                if !finite3(&r.value) {
+                    return Err(err(
+                        loc(r),
+                        "initial.omega_rpm",
+                        "expected three finite numbers (rev/min)".into(),
+                    ));
+                }
+                Vector3::from(r.value) * (2.0 * std::f64::consts::PI / 60.0)
+            }
+            (None, None) => {
+                return Err(err(
+                    None,
+                    "initial",
+                    "missing the body rates: expected `omega: [wx, wy, wz]` (rad/s) or \
+                     `omega_rpm: [..]`"
+                        .into(),
+                ));
+            }
+        };
+        let attitude0 = match &self.initial.attitude {
+            None => UnitQuaternion::identity(),
+            Some(a) => {
+                let q = Quaternion::new(a.value.w, a.value.x, a.value.y, a.value.z);
+                let n = q.norm();
+                if !q.coords.iter().all(|c| c.is_finite()) || (n - 1.0).abs() > 1e-6 {
+                    return Err(err(
+                        loc(a),
+                        "initial.attitude",
+                        format!(
+                            "expected a unit quaternion {{w, x, y, z}} (norm within 1e-6 of 1), \
+                             got norm {n}"
+                        ),
+                    ));
+                }
+                UnitQuaternion::from_quaternion(q)
+            }
+        };
+
+        // Spin axis: given, or the principal axis closest to the initial angular momentum.
+        let spin_axis = match &self.body.spin_axis {
+            Some(s) => {
+                let v = Vector3::from(s.value);
+                if !finite3(&s.value) || v.norm() == 0.0 {
+                    return Err(err(
+                        loc(s),
+                        "body.spin_axis",
+                        "expected a non-zero vector of three finite numbers (body axes)".into(),
+                    ));
+                }
+                v.normalize()
+            }
+            None => {
+                let h = hub.inertia * omega0;
+                let axes = hub.principal_axes;
+                let best = (0..3)
+                    .max_by(|&a, &b| {
+                        let da = axes.column(a).dot(&h).abs();
+                        let db = axes.column(b).dot(&h).abs();
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(2);
+                axes.column(best).into_owned()
+            }
+        };
+
+        // Duration.
+        let duration = ov.duration.unwrap_or(self.duration.value);
+        if !(duration.is_finite() && duration > 0.0) {
+            return Err(err(
+                loc(&self.duration),
+                "duration",
+                format!("expected a positive, finite number of seconds, got {duration}"),
+            ));
+        }
+
+        // Integrator.
+        let spec = self.integrator.unwrap_or_default();
+        let method_loc = spec.method.as_ref().and_then(loc);
+        let method_name = ov
+            .method
+            .clone()
+            .or(spec.method.as_ref().map(|m| m.value.clone()))
+            .unwrap_or_else(|| "dopri5".into());
+        let positive = |v: Option<f64>, s: &Option<Spanned<f64>>, field: &str, what: &str| match v
+            .or(s.as_ref().map(|x| x.value))
+        {
+            None => Ok(None),
+            Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
+            Some(x) => Err(err(
+                s.as_ref().and_then(loc),
+                field,
+                format!("expected a positive, finite {what}, got {x}"),
+            )),
+        };
+        let dt = positive(ov.dt, &spec.dt, "integrator.dt", "step in seconds")?;
+        let rtol = positive(ov.rtol, &spec.rtol, "integrator.rtol", "relative tolerance")?;
+        let atol = positive(ov.atol, &spec.atol, "integrator.atol", "absolute tolerance")?;
+        let max_step = positive(
+            None,
+            &spec.max_step,
+            "integrator.max_step",
+            "step in seconds",
+        )?;
+        let method = match method_name.as_str() {
+            "rk4" => Method::Rk4 {
+                dt: dt.ok_or_else(|| {
+                    err(
+                        method_loc,
+                        "integrator.dt",
+                        "rk4 needs a step: expected `dt: <seconds>` (or --dt)".into(),
+                    )
+                })?,
+            },
+            "dopri5" => Method::Dopri5 {
+                rtol: rtol.unwrap_or(1e-10),
+                atol: atol.unwrap_or(1e-12),
+                max_step: max_step.unwrap_or(f64::INFINITY),
+            },
+            "exact" => Method::Exact,
+            other => {
+                let hint = nearest(other, Method::NAMES)
+                    .map(|b| format!("; did you mean `{b}`?"))
+                    .unwrap_or_default();
+                return Err(err(
+                    method_loc,
+                    "integrator.method",
+                    format!(
+                        "unknown method `{other}`, expected one of {}{hint}",
+                        Method::NAMES.join(", ")
+                    ),
+                ));
+            }
+        };
+        if let Method::Rk4 { dt } = method
+            && duration / dt > 1e11
+        {
+            return Err(err(
+                spec.dt.as_ref().and_then(loc),
+                "integrator.dt",
+                format!(
+                    "{:.1e} steps of {dt} s over {duration} s is too many",
+                    duration / dt
+                ),
+            ));
+        }
+        if let Method::Dopri5 { rtol, .. } = method
+            && rtol < 1e-15
+        {
+            return Err(err(
+                spec.rtol.as_ref().and_then(loc),
+                "integrator.rtol",
+                format!("rtol {rtol:e} is below double precision; use at least 1e-15"),
+            ));
+        }
+
+        // Output.
+        let out = self.output.unwrap_or_default();
+        let output_rate = match &out.rate {
+            None => 100.0,
+            Some(r) if r.value.is_finite() && r.value > 0.0 => r.value,
+            Some(r) => {
+                return Err(err(
+                    loc(r),
+                    "output.rate",
+                    format!(
+                        "expected a positive number of samples per second, got {}",
+                        r.value
+                    ),
+                ));
+            }
+        };
+        if duration * output_rate > MAX_SAMPLES {
+            return Err(err(
+                out.rate.as_ref().and_then(loc).or(loc(&self.duration)),
+                "output.rate",
+                format!(
+                    "{:.3e} samples ({duration} s at {output_rate} Hz) exceed the limit of \
+                     {MAX_SAMPLES:e}; lower the rate or the duration",
+                    duration * output_rate
+                ),
+            ));
+        }
+        let scene_rate = match &out.scene_rate {
+            None => 10.0,
+            Some(r) if r.value.is_finite() && r.value > 0.0 => r.value,
+            Some(r) => {
+                return Err(err(
+                    loc(r),
+                    "output.scene_rate",
+                    format!("expected a positive number of updates per second, got {}", r.value),
+                ));
+            }
+        };
+        let mcap_path = match (&ov.mcap, &out.mcap) {
+            (Some(p), _) => p.clone(),
+            (None, Some(p)) if !p.value.trim().is_empty() => PathBuf::from(&p.value),
+            (None, Some(p)) => {
+                return Err(err(loc(p), "output.mcap", "expected a file path".into()));
+            }
+            (None, None) => PathBuf::from(format!("logs/{}.mcap", sanitize(&name))),
+        };
+
+        // Epoch.
+        let epoch_unix_ns = match &self.epoch {
+            None => parse_epoch(DEFAULT_EPOCH).expect("the default epoch parses"),
+            Some(e) => parse_epoch(&e.value).map_err(|m| err(loc(e), "epoch", m))?,
+        };
+
+        let stop = conditions(path, "stop", &self.stop)?;
+        let events = conditions(path, "events", &self.events)?;
+
+        let shape = match &self.body.shape {
+            None => Shape::Box {
+                size: hub.equivalent_box(1.0),
+                orientation: UnitQuaternion::from_matrix(&hub.principal_axes),
+            },
+            Some(s) => shape(path, s)?,
+        };
+
+        Ok(Scenario {
+            path: path.to_path_buf(),
+            source,
+            name,
+            description: self.description.unwrap_or_default(),
+            epoch_unix_ns,
+            spacecraft: Spacecraft::new(hub, spin_axis),
+            omega0,
+            attitude0,
+            duration,
+            method,
+            output_rate,
+            mcap_path,
+            scene_rate,
+            compression: out.compression.unwrap_or_default(),
+            stop,
+            events,
+            shape,
+        })
+    }
+}
+
+fn sanitize(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
+}
+
+fn conditions(
+    path: &Path,
+    field: &str,
+    specs: &[Spanned<ConditionSpec>],
+) -> Result<Vec<Condition>, ScenarioError> {
+    specs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (quantity, th) = match &s.value {
+                ConditionSpec::NutationAngleDeg(t) => (Quantity::NutationAngleDeg, t),
+                ConditionSpec::AngleToPrincipal1Deg(t) => (Quantity::AngleToPrincipalDeg(0), t),
+                ConditionSpec::AngleToPrincipal2Deg(t) => (Quantity::AngleToPrincipalDeg(1), t),
+                ConditionSpec::AngleToPrincipal3Deg(t) => (Quantity::AngleToPrincipalDeg(2), t),
+                ConditionSpec::OmegaX(t) => (Quantity::Omega(0), t),
+                ConditionSpec::OmegaY(t) => (Quantity::Omega(1), t),
+                ConditionSpec::OmegaZ(t) => (Quantity::Omega(2), t),
+                ConditionSpec::KineticEnergy(t) => (Quantity::KineticEnergy, t),
+            };
+            let field = format!("{field}[{i}].{}", quantity.key());
+            let (threshold, above) = match (th.above, th.below) {
+                (Some(a), None) => (a, true),
+                (None, Some(b)) => (b, false),
+                _ => {
+                    return Err(ScenarioError::at(
+                        path,
+                        loc(s),
+                        field,
+                        "expected exactly one of `above: <value>` or `below: <value>`",
+                    ));
+                }
+            };
+            if !threshold.is_finite() {
+                return Err(ScenarioError::at(
+                    path,
+                    loc(s),
+                    field,
+                    "expected a finite threshold",
+                ));
+            }
+            Ok(Condition {
+                quantity,
+                threshold,
+                above,
+            })
+        })
+        .collect()
+}
+
+fn shape(path: &Path, s: &Spanned<ShapeSpec>) -> Result<Shape, ScenarioError> {
+    let bad = |m: &str| ScenarioError::at(path, loc(s), "body.shape", m);
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    match &s.value {
+        ShapeSpec::Box { size } => {
+            if !size.iter().all(|&x| positive(x)) {
+                return Err(bad("expected three positive box side lengths (m)"));
+            }
+            Ok(Shape::Box {
+                size: Vector3::from(*size),
+                orientation: UnitQuaternion::identity(),
+            })
+        }
+        ShapeSpec::Cylinder {
+            radius,
+            length,
+            axis,
+        } => {
+            if !positive(*radius) || !positive(*length) {
+                return Err(bad("expected a positive radius and length (m)"));
+            }
+            let axis = Vector3::from(axis.unwrap_or([0.0, 0.0, 1.0]));
+            if !axis.iter().all(|x| x.is_finite()) || axis.norm() == 0.0 {
+                return Err(bad("expected a non-zero cylinder axis"));
+            }
+            let orientation = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
+                .unwrap_or_else(|| {
+                    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
+                });
+            Ok(Shape::Cylinder {
+                radius: *radius,
+                length: *length,
+                orientation,
+            })
+        }
+    }
+}
