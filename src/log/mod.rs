@@ -1,0 +1,446 @@
+//! MCAP logs for Foxglove and Rerun (topics and conventions in `docs/logs.md`).
+//!
+//! Topics: `/tf` (`foxglove.FrameTransforms`, world → body), `/scene` (`foxglove.SceneUpdate`,
+//! the body and arrows for ω and H, frame-locked to `body`), `/telemetry` (`polhode.Telemetry`)
+//! and `/log` (`foxglove.Log`, events and the run's end). All protobuf, schemas embedded.
+//! Log time = scenario epoch + sim time. The file is written under a temporary name in the
+//! target directory and renamed when finished, so a final name never holds a half-written log.
+
+pub mod telemetry;
+
+use crate::model::Observation;
+use crate::scenario::{Compression, Scenario, Shape, format_epoch};
+use crate::sim::{EventRecord, Outcome, Reference, Sink};
+use foxglove::Encode;
+use foxglove::messages as fg;
+use mcap::records::MessageHeader;
+use nalgebra::{UnitQuaternion, Vector3};
+use std::borrow::Cow;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{self, BufWriter};
+use std::path::{Path, PathBuf};
+
+/// Frame names used in `/tf` and `/scene`.
+pub const WORLD_FRAME: &str = "world";
+/// The body frame.
+pub const BODY_FRAME: &str = "body";
+
+/// Writes one run to an MCAP file.
+pub struct McapLogger {
+    writer: mcap::Writer<BufWriter<File>>,
+    temp_path: PathBuf,
+    final_path: PathBuf,
+    epoch_ns: u64,
+    channels: Channels,
+    sequence: u32,
+    scene: SceneStyle,
+    buf: Vec<u8>,
+}
+
+struct Channels {
+    tf: u16,
+    scene: u16,
+    telemetry: u16,
+    log: u16,
+}
+
+/// Static drawing parameters, fixed at the start of the run.
+struct SceneStyle {
+    shape: Shape,
+    /// Arrow length for the initial |ω| and |H| (m).
+    arrow_length: f64,
+    omega_ref: f64,
+    h_ref: f64,
+    /// Smallest sim-time interval between `/scene` updates (s).
+    interval: f64,
+    /// Sim time of the last `/scene` update.
+    last: Option<f64>,
+}
+
+fn io_err(e: mcap::McapError) -> io::Error {
+    io::Error::other(e.to_string())
+}
+
+fn add<T: Encode>(w: &mut mcap::Writer<BufWriter<File>>, topic: &str) -> io::Result<u16> {
+    let schema = T::get_schema().ok_or_else(|| io::Error::other("message without schema"))?;
+    let id = w
+        .add_schema(&schema.name, &schema.encoding, &schema.data)
+        .map_err(io_err)?;
+    w.add_channel(id, topic, &T::get_message_encoding(), &BTreeMap::new())
+        .map_err(io_err)
+}
+
+impl McapLogger {
+    /// Creates the temporary file next to `path` and writes the header, schemas and
+    /// channels. Fails before any integration if the location is not writable.
+    pub fn create(path: &Path, scenario: &Scenario, outcome_ref_omega: f64) -> io::Result<Self> {
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        if path.is_dir() {
+            return Err(io::Error::other(format!(
+                "{} is a directory; expected a file path ending in .mcap",
+                path.display()
+            )));
+        }
+        std::fs::create_dir_all(&dir)?;
+        let file_name = path
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "run.mcap".into());
+        let temp_path = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
+        let file = File::create(&temp_path)?;
+        let options = mcap::WriteOptions::new()
+            .compression(match scenario.compression {
+                Compression::Lz4 => Some(mcap::Compression::Lz4),
+                Compression::Zstd => Some(mcap::Compression::Zstd),
+                Compression::None => None,
+            })
+            .compression_threads(0)
+            .profile("")
+            .library(format!("polhode {}", env!("CARGO_PKG_VERSION")));
+        let result = (|| {
+            let mut writer = options
+                .create(BufWriter::with_capacity(1 << 16, file))
+                .map_err(io_err)?;
+            let tf = add::<fg::FrameTransforms>(&mut writer, "/tf")?;
+            let scene = add::<fg::SceneUpdate>(&mut writer, "/scene")?;
+            let schema = telemetry::schema_bytes();
+            let tid = writer
+                .add_schema(telemetry::SCHEMA_NAME, "protobuf", &schema)
+                .map_err(io_err)?;
+            let telemetry = writer
+                .add_channel(tid, "/telemetry", "protobuf", &BTreeMap::new())
+                .map_err(io_err)?;
+            let log = add::<fg::Log>(&mut writer, "/log")?;
+            Ok::<_, io::Error>((
+                writer,
+                Channels {
+                    tf,
+                    scene,
+                    telemetry,
+                    log,
+                },
+            ))
+        })();
+        let (writer, channels) = match result {
+            Ok(x) => x,
+            Err(e) => {
+                let _ = std::fs::remove_file(&temp_path);
+                return Err(e);
+            }
+        };
+        let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
+        let size = match &scenario.shape {
+            Shape::Box { size, .. } => size.max(),
+            Shape::Cylinder { radius, length, .. } => length.max(2.0 * radius),
+        };
+        Ok(McapLogger {
+            writer,
+            temp_path,
+            final_path: path.to_path_buf(),
+            epoch_ns: scenario.epoch_unix_ns,
+            channels,
+            sequence: 0,
+            scene: SceneStyle {
+                shape: scenario.shape.clone(),
+                arrow_length: 0.9 * size,
+                omega_ref: outcome_ref_omega.max(f64::MIN_POSITIVE),
+                h_ref: h0.max(f64::MIN_POSITIVE),
+                interval: 1.0 / scenario.scene_rate,
+                last: None,
+            },
+            buf: Vec::with_capacity(1024),
+        })
+    }
+
+    /// Where the finished log will be.
+    pub fn final_path(&self) -> &Path {
+        &self.final_path
+    }
+
+    fn log_time(&self, t: f64) -> u64 {
+        self.epoch_ns + (t * 1e9).round() as u64
+    }
+
+    fn timestamp(&self, t: f64) -> fg::Timestamp {
+        let ns = self.log_time(t);
+        fg::Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
+    }
+
+    fn write_raw(&mut self, channel: u16, log_time: u64) -> io::Result<()> {
+        self.sequence = self.sequence.wrapping_add(1);
+        let header = MessageHeader {
+            channel_id: channel,
+            sequence: self.sequence,
+            log_time,
+            publish_time: log_time,
+        };
+        self.writer
+            .write_to_known_channel(&header, &self.buf)
+            .map_err(io_err)
+    }
+
+    fn write<T: Encode>(&mut self, channel: u16, t: f64, msg: &T) -> io::Result<()> {
+        self.buf.clear();
+        msg.encode(&mut self.buf)
+            .map_err(|e| io::Error::other(e.to_string()))?;
+        self.write_raw(channel, self.log_time(t))
+    }
+
+    /// Writes a text line to `/log` at sim time `t`.
+    pub fn log_text(&mut self, t: f64, level: fg::log::Level, text: &str) -> io::Result<()> {
+        let msg = fg::Log {
+            timestamp: Some(self.timestamp(t)),
+            level: level as i32,
+            message: text.to_string(),
+            name: "polhode".into(),
+            file: String::new(),
+            line: 0,
+        };
+        self.write(self.channels.log, t, &msg)
+    }
+
+    /// Writes the run's metadata and the scenario attachment, finishes the file and renames
+    /// it to its final name.
+    pub fn finish(
+        mut self,
+        scenario: &Scenario,
+        method: &str,
+        outcome: &Outcome,
+    ) -> io::Result<PathBuf> {
+        let t_end = outcome.final_observation.t;
+        let level = match outcome.status {
+            crate::sim::Status::Completed | crate::sim::Status::Stopped { .. } => {
+                fg::log::Level::Info
+            }
+            _ => fg::log::Level::Warning,
+        };
+        let text = match &outcome.status {
+            crate::sim::Status::Completed => format!("run complete at t = {t_end} s"),
+            crate::sim::Status::Stopped { condition } => {
+                format!("run stopped at t = {t_end} s: {condition}")
+            }
+            crate::sim::Status::Interrupted => {
+                format!("run interrupted at t = {t_end} s; this log is partial")
+            }
+            crate::sim::Status::Failed { diagnosis } => {
+                format!("run failed; this log is partial: {diagnosis}")
+            }
+        };
+        self.log_text(t_end, level, &text)?;
+        let mut meta = BTreeMap::new();
+        meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+        meta.insert("scenario".into(), scenario.name.clone());
+        meta.insert("scenario_file".into(), scenario.path.display().to_string());
+        meta.insert("integrator".into(), method.into());
+        meta.insert("epoch".into(), format_epoch(self.epoch_ns));
+        meta.insert(
+            "quaternion_convention".into(),
+            "Hamilton; body to world (v_world = q v_body q*); /tf stores x,y,z,w; \
+             /telemetry stores q_w,q_x,q_y,q_z"
+                .into(),
+        );
+        meta.insert("status".into(), outcome.status.label().into());
+        meta.insert("sim_time_end".into(), format!("{t_end}"));
+        meta.insert("steps".into(), outcome.stats.steps.to_string());
+        meta.insert(
+            "rhs_evaluations".into(),
+            outcome.stats.rhs_evaluations.to_string(),
+        );
+        self.writer
+            .write_metadata(&mcap::records::Metadata {
+                name: "polhode".into(),
+                metadata: meta,
+            })
+            .map_err(io_err)?;
+        self.writer
+            .attach(&mcap::Attachment {
+                log_time: self.epoch_ns,
+                create_time: self.epoch_ns,
+                name: "scenario.yaml".into(),
+                media_type: "application/yaml".into(),
+                data: Cow::Borrowed(scenario.source.as_bytes()),
+            })
+            .map_err(io_err)?;
+        let McapLogger {
+            mut writer,
+            temp_path,
+            final_path,
+            ..
+        } = self;
+        let result = (|| {
+            writer.finish().map_err(io_err)?;
+            let file = writer
+                .into_inner()
+                .into_inner()
+                .map_err(|e| e.into_error())?;
+            file.sync_all()?;
+            std::fs::rename(&temp_path, &final_path)
+        })();
+        match result {
+            Ok(()) => Ok(final_path),
+            Err(e) => {
+                let _ = std::fs::remove_file(&temp_path);
+                Err(e)
+            }
+        }
+    }
+
+    /// Removes the temporary file (after an error that leaves nothing worth keeping).
+    pub fn abandon(self) {
+        let _ = std::fs::remove_file(&self.temp_path);
+    }
+
+    fn scene_update(&self, o: &Observation) -> fg::SceneUpdate {
+        let color = |r, g, b, a| Some(fg::Color { r, g, b, a });
+        let quat = |q: &UnitQuaternion<f64>| {
+            Some(fg::Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            })
+        };
+        let origin = Some(fg::Vector3 {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+        });
+        let arrow = |v: &Vector3<f64>, reference: f64, rgb: (f64, f64, f64)| {
+            let n = v.norm();
+            let length = self.scene.arrow_length * (n / reference).min(2.0);
+            let orientation =
+                UnitQuaternion::rotation_between(&Vector3::x(), v).unwrap_or_else(|| {
+                    if v.x < 0.0 {
+                        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI)
+                    } else {
+                        UnitQuaternion::identity()
+                    }
+                });
+            let head = (0.2 * self.scene.arrow_length).min(0.5 * length);
+            fg::ArrowPrimitive {
+                pose: Some(fg::Pose {
+                    position: origin,
+                    orientation: quat(&orientation),
+                }),
+                shaft_length: (length - head).max(0.0),
+                shaft_diameter: 0.03 * self.scene.arrow_length,
+                head_length: head,
+                head_diameter: 0.08 * self.scene.arrow_length,
+                color: color(rgb.0, rgb.1, rgb.2, 1.0),
+            }
+        };
+        let body_color = color(0.75, 0.75, 0.8, 0.85);
+        let (cubes, cylinders) = match &self.scene.shape {
+            Shape::Box { size, orientation } => (
+                vec![fg::CubePrimitive {
+                    pose: Some(fg::Pose {
+                        position: origin,
+                        orientation: quat(orientation),
+                    }),
+                    size: Some(fg::Vector3 {
+                        x: size[0],
+                        y: size[1],
+                        z: size[2],
+                    }),
+                    color: body_color,
+                }],
+                vec![],
+            ),
+            Shape::Cylinder {
+                radius,
+                length,
+                orientation,
+            } => (
+                vec![],
+                vec![fg::CylinderPrimitive {
+                    pose: Some(fg::Pose {
+                        position: origin,
+                        orientation: quat(orientation),
+                    }),
+                    size: Some(fg::Vector3 {
+                        x: 2.0 * radius,
+                        y: 2.0 * radius,
+                        z: *length,
+                    }),
+                    bottom_scale: 1.0,
+                    top_scale: 1.0,
+                    color: body_color,
+                }],
+            ),
+        };
+        fg::SceneUpdate {
+            deletions: vec![],
+            entities: vec![fg::SceneEntity {
+                timestamp: Some(self.timestamp(o.t)),
+                frame_id: BODY_FRAME.into(),
+                id: "spacecraft".into(),
+                lifetime: None,
+                frame_locked: true,
+                metadata: vec![],
+                arrows: vec![
+                    arrow(&o.omega, self.scene.omega_ref, (0.95, 0.55, 0.1)),
+                    arrow(&o.h_body, self.scene.h_ref, (0.2, 0.5, 1.0)),
+                ],
+                cubes,
+                spheres: vec![],
+                cylinders,
+                lines: vec![],
+                triangles: vec![],
+                texts: vec![],
+                models: vec![],
+            }],
+        }
+    }
+}
+
+impl Sink for McapLogger {
+    fn sample(&mut self, o: &Observation, _y: &[f64], inv: &Reference) -> io::Result<()> {
+        let q = o.attitude;
+        let tf = fg::FrameTransforms {
+            transforms: vec![fg::FrameTransform {
+                timestamp: Some(self.timestamp(o.t)),
+                parent_frame_id: WORLD_FRAME.into(),
+                child_frame_id: BODY_FRAME.into(),
+                translation: Some(fg::Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                }),
+                rotation: Some(fg::Quaternion {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                }),
+            }],
+        };
+        self.write(self.channels.tf, o.t, &tf)?;
+        // Allow for rounding of the sample grid so that a 10 Hz scene is not skipped at 100 Hz.
+        let due = self
+            .scene
+            .last
+            .is_none_or(|last| o.t - last >= self.scene.interval * (1.0 - 1e-9));
+        if due {
+            let scene = self.scene_update(o);
+            self.write(self.channels.scene, o.t, &scene)?;
+            self.scene.last = Some(o.t);
+        }
+        let values = telemetry::values(o, inv);
+        telemetry::encode_doubles(&values, &mut self.buf);
+        self.write_raw(self.channels.telemetry, self.log_time(o.t))
+    }
+
+    fn event(&mut self, e: &EventRecord, o: &Observation) -> io::Result<()> {
+        let text = format!(
+            "event at t = {:.9} s: {} (nutation {:.4}°)",
+            e.t,
+            e.condition,
+            o.nutation_angle.to_degrees()
+        );
+        self.log_text(e.t, fg::log::Level::Info, &text)
+    }
+}

@@ -1,0 +1,573 @@
+//! The run loop: integrate, sample the output grid, locate events, track invariant drift.
+//!
+//! Output samples fall at `k / rate` seconds of sim time (plus the final instant) and are read
+//! from the method's dense output, so the output rate never constrains the step. Events are
+//! sign changes of `Condition::margin`, bracketed at step ends (and at interior points) and
+//! located by the Illinois variant of regula falsi on the dense output.
+
+use crate::exact::TorqueFreeSolution;
+use crate::integrate::{Dopri5, OdeSystem, Rk4, Stats, StepError, Stepper, Tolerances};
+use crate::model::{Invariants, Observation, Spacecraft};
+use crate::scenario::{Condition, Method, Scenario};
+use nalgebra::{UnitQuaternion, Vector3};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// A recorded event: a condition became true.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EventRecord {
+    /// Sim time at which the condition became true (s).
+    pub t: f64,
+    /// The condition, e.g. `nutation_angle_deg above 89`.
+    pub condition: String,
+    /// Whether it ended the run.
+    pub terminal: bool,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Status {
+    /// Reached the scenario's duration.
+    Completed,
+    /// A stop condition became true.
+    Stopped {
+        /// The condition.
+        condition: String,
+    },
+    /// Interrupted by the user (Ctrl-C); what was computed is kept.
+    Interrupted,
+    /// The integration could not continue; what was computed is kept.
+    Failed {
+        /// Diagnosis: what happened, where, and what to try.
+        diagnosis: String,
+    },
+}
+
+impl Status {
+    /// A one-word label for metadata.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Status::Completed => "complete",
+            Status::Stopped { .. } => "stopped",
+            Status::Interrupted => "interrupted (partial)",
+            Status::Failed { .. } => "failed (partial)",
+        }
+    }
+}
+
+/// Largest deviations of the invariants over all accepted steps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Drift {
+    /// max |(|H| − |H₀|)| / |H₀|.
+    pub h_norm_rel: f64,
+    /// max |H_N − H_N₀| / |H₀| (the inertial momentum vector).
+    pub h_inertial_rel: f64,
+    /// max |(T − T₀)| / T₀.
+    pub kinetic_energy_rel: f64,
+    /// max ||q| − 1|.
+    pub q_norm: f64,
+}
+
+/// Initial values the drift is measured against.
+#[derive(Debug, Clone, Copy)]
+pub struct Reference {
+    h0: f64,
+    h_inertial0: Vector3<f64>,
+    t0: f64,
+}
+
+impl Reference {
+    /// The invariants of the initial observation.
+    pub fn of(o: &Observation) -> Self {
+        Reference {
+            h0: o.h_norm,
+            h_inertial0: o.h_inertial,
+            t0: o.kinetic_energy,
+        }
+    }
+
+    /// Signed relative change of |H| at `o`.
+    pub fn h_rel(&self, o: &Observation) -> f64 {
+        rel(o.h_norm - self.h0, self.h0)
+    }
+
+    /// Signed relative change of T at `o`.
+    pub fn t_rel(&self, o: &Observation) -> f64 {
+        rel(o.kinetic_energy - self.t0, self.t0)
+    }
+
+    fn update(&self, d: &mut Drift, i: &Invariants) {
+        let h = rel(i.h_body.norm() - self.h0, self.h0);
+        d.h_norm_rel = d.h_norm_rel.max(h.abs());
+        let t = rel(i.kinetic_energy - self.t0, self.t0);
+        d.kinetic_energy_rel = d.kinetic_energy_rel.max(t.abs());
+        d.h_inertial_rel = d
+            .h_inertial_rel
+            .max(rel((i.h_inertial - self.h_inertial0).norm(), self.h0));
+        d.q_norm = d.q_norm.max(i.q_norm_error.abs());
+    }
+}
+
+fn rel(d: f64, reference: f64) -> f64 {
+    if reference != 0.0 { d / reference } else { d }
+}
+
+/// Receives what a run produces, in time order.
+pub trait Sink {
+    /// One output sample: the observation and the full state vector.
+    fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()>;
+    /// An event, at its located time.
+    fn event(&mut self, e: &EventRecord, o: &Observation) -> std::io::Result<()>;
+}
+
+/// A sink that discards everything (runs without logging).
+pub struct NullSink;
+
+impl Sink for NullSink {
+    fn sample(&mut self, _: &Observation, _: &[f64], _: &Reference) -> std::io::Result<()> {
+        Ok(())
+    }
+    fn event(&mut self, _: &EventRecord, _: &Observation) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Run controls from the caller.
+pub struct Control<'a> {
+    /// Set asynchronously (e.g. by a Ctrl-C handler) to stop after the current step.
+    pub interrupt: &'a AtomicBool,
+    /// Called now and then with the sim time reached (s), for progress displays.
+    pub progress: Option<&'a mut dyn FnMut(f64)>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Outcome {
+    /// How it ended.
+    pub status: Status,
+    /// Observation at the last instant reached.
+    #[serde(skip)]
+    pub final_observation: Observation,
+    /// Initial observation.
+    #[serde(skip)]
+    pub initial_observation: Observation,
+    /// State vector at the last instant reached.
+    pub final_state: Vec<f64>,
+    /// Work counters.
+    pub stats: Stats,
+    /// Invariant drift over the run.
+    pub drift: Drift,
+    /// Events in time order.
+    pub events: Vec<EventRecord>,
+    /// Output samples emitted.
+    pub samples: u64,
+    /// Wall-clock time of the integration loop, including the sink (s).
+    pub wall_time: f64,
+}
+
+/// Runs `scenario` with its configured method, feeding `sink`.
+pub fn run(scenario: &Scenario, sink: &mut dyn Sink, ctl: Control) -> std::io::Result<Outcome> {
+    let sc = &scenario.spacecraft;
+    let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
+    match scenario.method {
+        Method::Rk4 { dt } => drive(Rk4::new(0.0, &y0, dt), scenario, sink, ctl, 0),
+        Method::Dopri5 {
+            rtol,
+            atol,
+            max_step,
+        } => {
+            let tol = Tolerances { rtol, atol };
+            drive(
+                Dopri5::new(0.0, &y0, tol, max_step, None),
+                scenario,
+                sink,
+                ctl,
+                3,
+            )
+        }
+        Method::Exact => match ExactStepper::new(sc, &y0, scenario.output_rate) {
+            Ok(stepper) => drive(stepper, scenario, sink, ctl, 3),
+            Err(diagnosis) => {
+                let o = sc.observe(0.0, &y0);
+                Ok(Outcome {
+                    status: Status::Failed { diagnosis },
+                    final_observation: o.clone(),
+                    initial_observation: o,
+                    final_state: y0,
+                    stats: Stats::default(),
+                    drift: Drift::default(),
+                    events: vec![],
+                    samples: 0,
+                    wall_time: 0.0,
+                })
+            }
+        },
+    }
+}
+
+/// The closed-form torque-free solution as a [`Stepper`]: steps are evaluation points
+/// (at most a fraction of a polhode period apart, so events are bracketed), and
+/// interpolation is exact.
+pub struct ExactStepper {
+    solution: TorqueFreeSolution,
+    h: f64,
+    t: f64,
+    t_prev: f64,
+    y: Vec<f64>,
+    stats: Stats,
+}
+
+impl ExactStepper {
+    /// Refuses spacecraft with effectors: the closed form is for the torque-free rigid body.
+    pub fn new(sc: &Spacecraft, y0: &[f64], output_rate: f64) -> Result<Self, String> {
+        if !sc.effectors().is_empty() {
+            return Err(
+                "method `exact` solves the torque-free rigid body only, and this \
+                        spacecraft has effectors; use dopri5 or rk4"
+                    .into(),
+            );
+        }
+        let omega0 = Vector3::new(y0[0], y0[1], y0[2]);
+        let q0 =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y0[3], y0[4], y0[5], y0[6]));
+        let solution = TorqueFreeSolution::new(&sc.hub.inertia, &omega0, &q0)
+            .map_err(|e| format!("the exact solution is not available: {e}"))?;
+        let period = solution.polhode_period();
+        // Rotation rate bounds how fast anything observable can change.
+        let spin = omega0.norm().max(1e-300);
+        let mut h = (1.0 / output_rate).min(0.25 / spin);
+        if period.is_finite() && period > 0.0 {
+            h = h.min(period / 32.0);
+        }
+        Ok(ExactStepper {
+            solution,
+            h,
+            t: 0.0,
+            t_prev: 0.0,
+            y: y0.to_vec(),
+            stats: Stats::default(),
+        })
+    }
+
+    fn evaluate(&self, t: f64, out: &mut [f64], reference: &[f64]) {
+        let (w, q) = self.solution.state_at(t);
+        // Keep the quaternion on the same hemisphere as the reference, for smooth telemetry.
+        let s = if q.w * reference[3] + q.i * reference[4] + q.j * reference[5] + q.k * reference[6]
+            < 0.0
+        {
+            -1.0
+        } else {
+            1.0
+        };
+        out[..3].copy_from_slice(w.as_slice());
+        out[3] = s * q.w;
+        out[4] = s * q.i;
+        out[5] = s * q.j;
+        out[6] = s * q.k;
+    }
+}
+
+impl Stepper for ExactStepper {
+    fn t(&self) -> f64 {
+        self.t
+    }
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+    fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+    fn step<S: OdeSystem + ?Sized>(&mut self, _sys: &S, t_end: f64) -> Result<f64, StepError> {
+        let t1 = if t_end - self.t <= self.h * (1.0 + 1e-9) {
+            t_end
+        } else {
+            self.t + self.h
+        };
+        let mut y = vec![0.0; 7];
+        self.evaluate(t1, &mut y, &self.y);
+        self.y = y;
+        self.t_prev = self.t;
+        self.t = t1;
+        self.stats.steps += 1;
+        Ok(t1)
+    }
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        self.evaluate(t, out, &self.y);
+    }
+}
+
+/// How often (in steps) the interrupt flag and the wall clock are looked at.
+const POLL_STEPS: u64 = 64;
+
+fn drive<M: Stepper>(
+    mut stepper: M,
+    scenario: &Scenario,
+    sink: &mut dyn Sink,
+    mut ctl: Control,
+    interior_checks: usize,
+) -> std::io::Result<Outcome> {
+    let started = Instant::now();
+    let sc = &scenario.spacecraft;
+    let t_end = scenario.duration;
+    let rate = scenario.output_rate;
+    let n = sc.dim();
+    let mut buf = vec![0.0; n];
+
+    let o0 = sc.observe(0.0, stepper.y());
+    let inv = Reference::of(&o0);
+    let mut drift = Drift::default();
+    let mut events: Vec<EventRecord> = Vec::new();
+    let conditions: Vec<(&Condition, bool)> = scenario
+        .stop
+        .iter()
+        .map(|c| (c, true))
+        .chain(scenario.events.iter().map(|c| (c, false)))
+        .collect();
+
+    sink.sample(&o0, stepper.y(), &inv)?;
+    let mut samples = 1u64;
+    let mut next_k = 1u64;
+    let mut last_sample_t = 0.0;
+
+    // Conditions already true at t = 0 fire at once.
+    let mut status = None;
+    for (c, terminal) in &conditions {
+        if c.margin(&o0) > 0.0 {
+            let e = EventRecord {
+                t: 0.0,
+                condition: c.describe(),
+                terminal: *terminal,
+            };
+            sink.event(&e, &o0)?;
+            events.push(e);
+            if *terminal && status.is_none() {
+                status = Some(Status::Stopped {
+                    condition: c.describe(),
+                });
+            }
+        }
+    }
+
+    let mut prev = o0.clone();
+    let mut last_obs = o0.clone();
+    let mut last_poll = Instant::now();
+    while status.is_none() && stepper.t() < t_end {
+        if stepper.stats().steps.is_multiple_of(POLL_STEPS) {
+            if ctl.interrupt.load(Ordering::Relaxed) {
+                status = Some(Status::Interrupted);
+                break;
+            }
+            if let Some(p) = ctl.progress.as_mut()
+                && last_poll.elapsed() > Duration::from_millis(100)
+            {
+                p(stepper.t());
+                last_poll = Instant::now();
+            }
+        }
+        let t0 = stepper.t();
+        if let Err(e) = stepper.step(sc, t_end) {
+            status = Some(Status::Failed {
+                diagnosis: diagnose(&e.to_string(), t0, stepper.y(), scenario),
+            });
+            break;
+        }
+        let t1 = stepper.t();
+        if !stepper.y().iter().all(|v| v.is_finite()) {
+            status = Some(Status::Failed {
+                diagnosis: diagnose("the state became non-finite", t1, stepper.y(), scenario),
+            });
+            break;
+        }
+        inv.update(&mut drift, &sc.invariants(t1, stepper.y()));
+        // The full observation (angles) only when events need it.
+        let o1 = if conditions.is_empty() {
+            None
+        } else {
+            Some(sc.observe(t1, stepper.y()))
+        };
+
+        // Events inside (t0, t1]: check interior points too, so that a quantity that crosses
+        // and re-crosses within one long step is not missed.
+        let mut found: Vec<(f64, &Condition, bool)> = Vec::new();
+        if let Some(o1) = &o1 {
+            let mut grid = vec![(t0, prev.clone())];
+            for j in 1..=interior_checks {
+                let t = t0 + (t1 - t0) * j as f64 / (interior_checks + 1) as f64;
+                stepper.interpolate(t, &mut buf);
+                grid.push((t, sc.observe(t, &buf)));
+            }
+            grid.push((t1, o1.clone()));
+            for (c, terminal) in &conditions {
+                for w in grid.windows(2) {
+                    let (ga, gb) = (c.margin(&w[0].1), c.margin(&w[1].1));
+                    if ga <= 0.0 && gb > 0.0 {
+                        let t = locate(&stepper, sc, c, w[0].0, w[1].0, ga, gb, &mut buf);
+                        found.push((t, c, *terminal));
+                        if *terminal {
+                            break;
+                        }
+                    }
+                }
+            }
+            found.sort_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some(i) = found.iter().position(|f| f.2) {
+                found.truncate(i + 1);
+            }
+        }
+        let stop_at = found.last().filter(|f| f.2).map(|f| f.0);
+        let horizon = stop_at.unwrap_or(t1);
+
+        // Samples on the grid up to the horizon, interleaved with events in time order.
+        let mut pending = found.iter().peekable();
+        loop {
+            let tk = next_k as f64 / rate;
+            let next_event_t = pending.peek().map(|f| f.0);
+            let sample_due = tk <= horizon && tk <= t_end;
+            match (sample_due, next_event_t) {
+                (true, Some(te)) if te < tk => {}
+                (true, _) => {
+                    let o = if tk == t1 {
+                        buf.copy_from_slice(stepper.y());
+                        o1.clone().unwrap_or_else(|| sc.observe(t1, &buf))
+                    } else {
+                        stepper.interpolate(tk, &mut buf);
+                        sc.observe(tk, &buf)
+                    };
+                    sink.sample(&o, &buf, &inv)?;
+                    samples += 1;
+                    next_k += 1;
+                    last_sample_t = tk;
+                    continue;
+                }
+                (false, None) => break,
+                (false, Some(_)) => {}
+            }
+            // An event comes first.
+            let Some(&(te, c, terminal)) = pending.next() else {
+                break;
+            };
+            stepper.interpolate(te, &mut buf);
+            let o = sc.observe(te, &buf);
+            let e = EventRecord {
+                t: te,
+                condition: c.describe(),
+                terminal,
+            };
+            sink.event(&e, &o)?;
+            events.push(e);
+            if terminal {
+                if te > last_sample_t {
+                    sink.sample(&o, &buf, &inv)?;
+                    samples += 1;
+                    last_sample_t = te;
+                }
+                last_obs = o;
+                status = Some(Status::Stopped {
+                    condition: c.describe(),
+                });
+                break;
+            }
+        }
+        if status.is_none()
+            && let Some(o1) = o1
+        {
+            prev = o1;
+        }
+    }
+    let status = status.unwrap_or(Status::Completed);
+    // The last instant reached is always logged, on the grid or not.
+    let final_state = if matches!(status, Status::Stopped { .. }) {
+        buf.clone()
+    } else {
+        stepper.y().to_vec()
+    };
+    if !matches!(status, Status::Stopped { .. }) {
+        let o = sc.observe(stepper.t(), stepper.y());
+        if stepper.t() > last_sample_t && stepper.y().iter().all(|v| v.is_finite()) {
+            sink.sample(&o, stepper.y(), &inv)?;
+            samples += 1;
+        }
+        last_obs = o;
+    }
+    if let Some(p) = ctl.progress.as_mut() {
+        p(last_obs.t);
+    }
+    Ok(Outcome {
+        status,
+        final_observation: last_obs,
+        initial_observation: o0,
+        final_state,
+        stats: stepper.stats(),
+        drift,
+        events,
+        samples,
+        wall_time: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Locates the root of `c.margin` in `[a, b]` on the dense output (Illinois regula falsi).
+#[allow(clippy::too_many_arguments)]
+fn locate<M: Stepper>(
+    stepper: &M,
+    sc: &Spacecraft,
+    c: &Condition,
+    mut a: f64,
+    mut b: f64,
+    mut ga: f64,
+    mut gb: f64,
+    buf: &mut [f64],
+) -> f64 {
+    let tol = 1e-13 * b.abs().max(1.0);
+    let mut side = 0i8;
+    for _ in 0..200 {
+        if (b - a).abs() <= tol {
+            break;
+        }
+        let t = ((a * gb - b * ga) / (gb - ga)).clamp(a.min(b), a.max(b));
+        stepper.interpolate(t, buf);
+        let g = c.margin(&sc.observe(t, buf));
+        if g > 0.0 {
+            b = t;
+            gb = g;
+            if side == 1 {
+                ga *= 0.5;
+            }
+            side = 1;
+        } else {
+            a = t;
+            ga = g;
+            if side == -1 {
+                gb *= 0.5;
+            }
+            side = -1;
+        }
+        if g == 0.0 {
+            return t;
+        }
+    }
+    b
+}
+
+/// A diagnosis for a failed integration: what, when, the state, and what to try.
+fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
+    let state: Vec<String> = y.iter().take(7).map(|v| format!("{v:.6e}")).collect();
+    let remedy = match scenario.method {
+        Method::Rk4 { dt } => format!(
+            "the fixed step dt = {dt:e} s may exceed the stability limit of rk4 for this \
+             scene: reduce dt, or use dopri5"
+        ),
+        Method::Dopri5 { .. } => "check the model parameters for a singularity (e.g. a \
+                                  vanishing inertia); loosen rtol/atol if the tolerance \
+                                  cannot be met"
+            .into(),
+        Method::Exact => "report this as a bug with the scenario attached".into(),
+    };
+    format!(
+        "{what} at t = {t} s; state [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        state.join(", ")
+    )
+}
