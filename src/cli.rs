@@ -1,0 +1,509 @@
+//! The `polhode` command line: `run`, `check`, `linearize` (stable; documented in docs/cli.md).
+//!
+//! Exit codes: 0 success; 2 bad input (scenario, options, unwritable output; nothing written);
+//! 1 an I/O failure during the run; 3 the integration failed (the log up to the failure is
+//! kept, marked partial); 130 interrupted by Ctrl-C (the log is kept, marked partial).
+
+use crate::linearize::{Linearization, linearize, spin_rate_of};
+use crate::log::McapLogger;
+use crate::scenario::{self, Overrides, Scenario};
+use crate::sim::{self, Control, NullSink, Outcome, Status};
+use clap::{Parser, Subcommand};
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Exit code for bad input.
+pub const EXIT_BAD_INPUT: i32 = 2;
+/// Exit code for an I/O failure during a run.
+pub const EXIT_IO: i32 = 1;
+/// Exit code for an integration failure.
+pub const EXIT_FAILED: i32 = 3;
+/// Exit code after Ctrl-C.
+pub const EXIT_INTERRUPTED: i32 = 130;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "polhode",
+    version,
+    about = "Spacecraft attitude dynamics with energy dissipation"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Run a scenario, write its MCAP log and print a summary.
+    Run {
+        /// Scenario YAML file.
+        scenario: PathBuf,
+        /// MCAP output (overrides `output.mcap`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Do not write an MCAP log.
+        #[arg(long, conflicts_with = "out")]
+        no_log: bool,
+        /// Integration method: rk4, dopri5 or exact.
+        #[arg(long)]
+        method: Option<String>,
+        /// Fixed step for rk4 (s).
+        #[arg(long)]
+        dt: Option<f64>,
+        /// Relative tolerance for adaptive methods.
+        #[arg(long)]
+        rtol: Option<f64>,
+        /// Absolute tolerance for adaptive methods.
+        #[arg(long)]
+        atol: Option<f64>,
+        /// Simulated duration (s), overrides `duration`.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Write a JSON summary here.
+        #[arg(long)]
+        summary: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Validate a scenario and exit.
+    Check {
+        /// Scenario YAML file(s).
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+    },
+    /// Eigenvalues of the linearisation about steady spin about the spin axis.
+    Linearize {
+        /// Scenario YAML file.
+        scenario: PathBuf,
+        /// Write JSON to this file (or print JSON with `--json -`).
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+/// Runs the command line; returns the process exit code.
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { EXIT_BAD_INPUT } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    match cli.command {
+        Command::Check { scenarios } => check(&scenarios),
+        Command::Linearize { scenario, json } => linearize_cmd(&scenario, json.as_deref()),
+        Command::Run {
+            scenario,
+            out,
+            no_log,
+            method,
+            dt,
+            rtol,
+            atol,
+            duration,
+            summary,
+            quiet,
+        } => {
+            let overrides = Overrides {
+                method,
+                dt,
+                rtol,
+                atol,
+                duration,
+                mcap: out,
+            };
+            run(&scenario, &overrides, no_log, summary.as_deref(), quiet)
+        }
+    }
+}
+
+fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, i32> {
+    scenario::load(path, overrides).map_err(|e| {
+        eprintln!("error: {e}");
+        EXIT_BAD_INPUT
+    })
+}
+
+fn check(paths: &[PathBuf]) -> i32 {
+    let mut code = 0;
+    for p in paths {
+        match load(p, &Overrides::default()) {
+            Ok(s) => println!(
+                "{}: ok ({}; {} s; {}; {} Hz to {})",
+                p.display(),
+                s.name,
+                s.duration,
+                s.method.describe(),
+                s.output_rate,
+                s.mcap_path.display()
+            ),
+            Err(c) => code = c,
+        }
+    }
+    code
+}
+
+fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
+    let s = match load(path, &Overrides::default()) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    let rate = spin_rate_of(&s.spacecraft, &s.omega0);
+    let lin = match linearize(&s.spacecraft, rate) {
+        Ok(l) => l,
+        Err(m) => {
+            eprintln!("error: {}: {m}", path.display());
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let text = serde_json::to_string_pretty(&lin).unwrap_or_default();
+    match json {
+        Some(p) if p == Path::new("-") => println!("{text}"),
+        Some(p) => {
+            if let Err(e) = write_atomically(p, text.as_bytes()) {
+                eprintln!("error: cannot write {}: {e}", p.display());
+                return EXIT_BAD_INPUT;
+            }
+            print_linearization(&s, &lin);
+        }
+        None => print_linearization(&s, &lin),
+    }
+    0
+}
+
+fn print_linearization(s: &Scenario, lin: &Linearization) {
+    let a = lin.spin_axis;
+    println!(
+        "{}: steady spin {:.6} rad/s about [{:.4}, {:.4}, {:.4}] (principal axis {} of \
+         I = {:.6}, {:.6}, {:.6} kg m²)",
+        s.name,
+        lin.spin_rate,
+        a[0],
+        a[1],
+        a[2],
+        lin.principal_axis,
+        lin.principal_moments[0],
+        lin.principal_moments[1],
+        lin.principal_moments[2]
+    );
+    println!(
+        "  {:>16} {:>16}  {:<12} time constant",
+        "Re (1/s)", "Im (rad/s)", "mode"
+    );
+    for m in &lin.modes {
+        let tc = m
+            .time_constant
+            .map(|t| format!("{t:.6} s"))
+            .unwrap_or_else(|| "-".into());
+        println!("  {:>16.9e} {:>16.9e}  {:<12} {tc}", m.re, m.im, m.kind);
+    }
+    println!("  verdict: {}", lin.verdict);
+    if let Some(tc) = lin.time_constant {
+        let what = if lin.max_growth_rate > 0.0 {
+            "growth"
+        } else {
+            "decay"
+        };
+        println!(
+            "  nutation {what} rate {:.9e} 1/s, time constant {tc:.6} s",
+            lin.max_growth_rate
+        );
+    }
+    let r = &lin.rigid_body_prediction;
+    if r.growth_rate > 0.0 {
+        println!("  rigid-body closed form: k = {:.9e} 1/s", r.growth_rate);
+    } else {
+        println!(
+            "  rigid-body closed form: nutation frequency {:.9e} rad/s",
+            r.frequency
+        );
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Checks up front that a file can be created at `path` (without leaving one behind).
+fn probe_writable(path: &Path) -> std::io::Result<()> {
+    if path.is_dir() {
+        return Err(std::io::Error::other("it is a directory"));
+    }
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let tmp = dir.join(format!(".polhode-probe.{}.tmp", std::process::id()));
+    std::fs::File::create(&tmp)?;
+    std::fs::remove_file(&tmp)
+}
+
+fn run(
+    path: &Path,
+    overrides: &Overrides,
+    no_log: bool,
+    summary_path: Option<&Path>,
+    quiet: bool,
+) -> i32 {
+    let s = match load(path, overrides) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    if let Some(p) = summary_path
+        && let Err(e) = probe_writable(p)
+    {
+        eprintln!("error: cannot write the summary to {}: {e}", p.display());
+        return EXIT_BAD_INPUT;
+    }
+    let mut logger = if no_log {
+        None
+    } else {
+        match McapLogger::create(&s.mcap_path, &s, s.omega0.norm()) {
+            Ok(l) => Some(l),
+            Err(e) => {
+                eprintln!(
+                    "error: cannot write the log to {}: {e}",
+                    s.mcap_path.display()
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    };
+
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        // A second Ctrl-C exits at once.
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                std::process::exit(EXIT_INTERRUPTED);
+            }
+        });
+    }
+    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new((s.duration * 1000.0).ceil() as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} sim {msg} ETA {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let mut progress = |t: f64| {
+        if let Some(b) = &bar {
+            b.set_position((t * 1000.0) as u64);
+            b.set_message(format!("{t:.3}/{} s", s.duration));
+        }
+    };
+    let ctl = Control {
+        interrupt: &interrupt,
+        progress: Some(&mut progress),
+    };
+    let result = match logger.as_mut() {
+        Some(l) => sim::run(&s, l, ctl),
+        None => sim::run(&s, &mut NullSink, ctl),
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let outcome = match result {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: writing the log failed: {e}; no log was kept");
+            if let Some(l) = logger {
+                l.abandon();
+            }
+            return EXIT_IO;
+        }
+    };
+    let mut written = None;
+    if let Some(l) = logger {
+        match l.finish(&s, &s.method.describe(), &outcome) {
+            Ok(p) => written = Some(p),
+            Err(e) => {
+                eprintln!(
+                    "error: finishing the log {} failed: {e}; no log was kept",
+                    s.mcap_path.display()
+                );
+                return EXIT_IO;
+            }
+        }
+    }
+    if let Some(p) = summary_path {
+        let json = summary_json(&s, &outcome, written.as_deref());
+        if let Err(e) = write_atomically(p, json.as_bytes()) {
+            eprintln!("error: cannot write the summary {}: {e}", p.display());
+            return EXIT_IO;
+        }
+    }
+    if !quiet {
+        print_summary(&s, &outcome, written.as_deref());
+    }
+    match &outcome.status {
+        Status::Completed | Status::Stopped { .. } => 0,
+        Status::Interrupted => {
+            eprintln!(
+                "interrupted at t = {} s: the log holds what was computed and is marked partial",
+                outcome.final_observation.t
+            );
+            EXIT_INTERRUPTED
+        }
+        Status::Failed { diagnosis } => {
+            eprintln!("error: the integration failed: {diagnosis}");
+            EXIT_FAILED
+        }
+    }
+}
+
+/// The `--summary` JSON document.
+#[derive(serde::Serialize)]
+struct Summary<'a> {
+    polhode_version: &'static str,
+    scenario: &'a str,
+    scenario_file: String,
+    method: &'static str,
+    method_settings: String,
+    status: &'a Status,
+    mcap: Option<String>,
+    initial: State,
+    #[serde(rename = "final")]
+    final_state: State,
+    drift: &'a sim::Drift,
+    steps: u64,
+    rejected_steps: u64,
+    rhs_evaluations: u64,
+    samples: u64,
+    wall_time_s: f64,
+    events: &'a [sim::EventRecord],
+}
+
+#[derive(serde::Serialize)]
+struct State {
+    t: f64,
+    omega: [f64; 3],
+    q: Quat,
+    kinetic_energy: f64,
+    h_norm: f64,
+    h_inertial: [f64; 3],
+    nutation_angle_deg: f64,
+}
+
+#[derive(serde::Serialize)]
+struct Quat {
+    w: f64,
+    x: f64,
+    y: f64,
+    z: f64,
+}
+
+fn state(o: &crate::model::Observation) -> State {
+    State {
+        t: o.t,
+        omega: [o.omega[0], o.omega[1], o.omega[2]],
+        q: Quat {
+            w: o.attitude.w,
+            x: o.attitude.i,
+            y: o.attitude.j,
+            z: o.attitude.k,
+        },
+        kinetic_energy: o.kinetic_energy,
+        h_norm: o.h_norm,
+        h_inertial: [o.h_inertial[0], o.h_inertial[1], o.h_inertial[2]],
+        nutation_angle_deg: o.nutation_angle.to_degrees(),
+    }
+}
+
+fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
+    let summary = Summary {
+        polhode_version: env!("CARGO_PKG_VERSION"),
+        scenario: &s.name,
+        scenario_file: s.path.display().to_string(),
+        method: s.method.name(),
+        method_settings: s.method.describe(),
+        status: &o.status,
+        mcap: mcap.map(|p| p.display().to_string()),
+        initial: state(&o.initial_observation),
+        final_state: state(&o.final_observation),
+        drift: &o.drift,
+        steps: o.stats.steps,
+        rejected_steps: o.stats.rejected_steps,
+        rhs_evaluations: o.stats.rhs_evaluations,
+        samples: o.samples,
+        wall_time_s: o.wall_time,
+        events: &o.events,
+    };
+    serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n"
+}
+
+fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
+    let f = &o.final_observation;
+    let q = f.attitude;
+    println!("{} — {}", s.name, s.method.describe());
+    println!(
+        "  status: {}{}",
+        o.status.label(),
+        match &o.status {
+            Status::Stopped { condition } => format!(" ({condition})"),
+            _ => String::new(),
+        }
+    );
+    println!("  t = {} s", f.t);
+    println!(
+        "  ω = [{:.9e}, {:.9e}, {:.9e}] rad/s",
+        f.omega[0], f.omega[1], f.omega[2]
+    );
+    println!(
+        "  q = {{w: {:.12}, x: {:.12}, y: {:.12}, z: {:.12}}}",
+        q.w, q.i, q.j, q.k
+    );
+    println!(
+        "  T = {:.12e} J   |H| = {:.12e} N m s   nutation {:.6}°",
+        f.kinetic_energy,
+        f.h_norm,
+        f.nutation_angle.to_degrees()
+    );
+    println!(
+        "  drift: |H| {:.3e}  H_N {:.3e}  T {:.3e}  |q| {:.3e}",
+        o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.kinetic_energy_rel, o.drift.q_norm
+    );
+    println!(
+        "  work: {} steps ({} rejected), {} RHS evaluations, {} samples, {:.3} s wall",
+        o.stats.steps, o.stats.rejected_steps, o.stats.rhs_evaluations, o.samples, o.wall_time
+    );
+    for e in &o.events {
+        println!(
+            "  event: t = {:.9} s  {}{}",
+            e.t,
+            e.condition,
+            if e.terminal { " (stop)" } else { "" }
+        );
+    }
+    if let Some(p) = mcap {
+        println!("  log: {}", p.display());
+    }
+}
