@@ -1,0 +1,156 @@
+//! Core benchmarks, reported as ratios against a baseline measured in the same process
+//! (the machines are shared and noisy; absolute times are printed for reference only).
+//!
+//!   cargo bench --bench core            # full
+//!   cargo bench --bench core -- --quick # fewer repeats
+//!
+//! 1. One RK4 step of the torque-free body through polhode's `Rk4` stepper and `Spacecraft`
+//!    system, against a minimal hand-written RK4 loop on `[f64; 7]` with the same equations.
+//! 2. A run that logs MCAP at 100 Hz against the same run without logging, on a cheap
+//!    adaptive scene (integration much cheaper than a sample) and a fixed-step one.
+//!
+//! Each measurement is the minimum over repeats, and the two sides alternate so that both see
+//! the same machine load.
+
+use polhode::integrate::{Rk4, Stepper};
+use polhode::log::McapLogger;
+use polhode::model::{RigidBody, Spacecraft};
+use polhode::scenario::{self, Overrides};
+use polhode::sim::{self, Control, NullSink};
+use std::hint::black_box;
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// The baseline: the torque-free body, RK4, fixed arrays, no abstraction.
+fn hand_written_rk4(inertia: [f64; 3], y: &mut [f64; 7], dt: f64, steps: usize) {
+    #[inline(always)]
+    fn f(i: &[f64; 3], y: &[f64; 7]) -> [f64; 7] {
+        let (p, q, r) = (y[0], y[1], y[2]);
+        let (w, x, yy, z) = (y[3], y[4], y[5], y[6]);
+        [
+            (i[1] - i[2]) / i[0] * q * r,
+            (i[2] - i[0]) / i[1] * r * p,
+            (i[0] - i[1]) / i[2] * p * q,
+            -0.5 * (x * p + yy * q + z * r),
+            0.5 * (w * p + yy * r - z * q),
+            0.5 * (w * q + z * p - x * r),
+            0.5 * (w * r + x * q - yy * p),
+        ]
+    }
+    let add = |a: &[f64; 7], k: &[f64; 7], h: f64| std::array::from_fn(|j| a[j] + h * k[j]);
+    for _ in 0..steps {
+        let k1 = f(&inertia, y);
+        let k2 = f(&inertia, &add(y, &k1, 0.5 * dt));
+        let k3 = f(&inertia, &add(y, &k2, 0.5 * dt));
+        let k4 = f(&inertia, &add(y, &k3, dt));
+        for j in 0..7 {
+            y[j] += dt / 6.0 * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j]);
+        }
+    }
+}
+
+fn min_time(repeats: usize, mut f: impl FnMut()) -> f64 {
+    (0..repeats)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn bench_rk4_step(repeats: usize) {
+    const STEPS: usize = 100_000;
+    let principal = [1.0, 2.0, 3.0];
+    let sc = Spacecraft::new(
+        RigidBody::from_principal(principal).unwrap(),
+        nalgebra::Vector3::z(),
+    );
+    let y0 = [0.3, 0.5, 0.8, 1.0, 0.0, 0.0, 0.0];
+    let dt = 1e-3;
+    let (mut best_polhode, mut best_hand) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        best_polhode = best_polhode.min(min_time(1, || {
+            let mut s = Rk4::new(0.0, &y0, dt);
+            for _ in 0..STEPS {
+                s.step(black_box(&sc), f64::INFINITY).unwrap();
+            }
+            black_box(s.y());
+        }));
+        best_hand = best_hand.min(min_time(1, || {
+            let mut y = y0;
+            hand_written_rk4(black_box(principal), &mut y, dt, STEPS);
+            black_box(y);
+        }));
+    }
+    let (p, h) = (best_polhode / STEPS as f64, best_hand / STEPS as f64);
+    println!(
+        "rk4 step, torque-free body: polhode {:.1} ns, hand-written {:.1} ns, ratio {:.2}",
+        p * 1e9,
+        h * 1e9,
+        p / h
+    );
+}
+
+/// Logging at 100 Hz against no logging, on one scene (`method` overrides the scenario's).
+fn bench_logging(repeats: usize, label: &str, method: &str, dt: Option<f64>) {
+    let path = Path::new("scenarios/generic-tumble.yaml");
+    let ov = Overrides {
+        duration: Some(200.0),
+        method: Some(method.into()),
+        dt,
+        ..Default::default()
+    };
+    let mut s = scenario::load(path, &ov).expect("scenario");
+    s.output_rate = 100.0;
+    let dir = std::env::temp_dir().join(format!("polhode-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("bench.mcap");
+    let stop = AtomicBool::new(false);
+    let ctl = || Control {
+        interrupt: &stop,
+        progress: None,
+    };
+    let (mut best_log, mut best_plain) = (f64::INFINITY, f64::INFINITY);
+    let (mut steps, mut samples) = (0, 0);
+    for _ in 0..repeats {
+        best_plain = best_plain.min(min_time(1, || {
+            let o = sim::run(&s, &mut NullSink, ctl()).unwrap();
+            (steps, samples) = (o.stats.steps, o.samples);
+        }));
+        // The whole logged run: create, integrate and write, finish (including the fsync).
+        best_log = best_log.min(min_time(1, || {
+            let mut l = McapLogger::create(&out, &s, s.omega0.norm()).unwrap();
+            let o = sim::run(&s, &mut l, ctl()).unwrap();
+            l.finish(&s, method, &o).unwrap();
+        }));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    println!(
+        "logging at 100 Hz, {label} ({steps} steps, {samples} samples): logged {:.2} ms, \
+         unlogged {:.2} ms, ratio {:.2}; logging costs {:.2} us per sample",
+        best_log * 1e3,
+        best_plain * 1e3,
+        best_log / best_plain,
+        (best_log - best_plain) / samples as f64 * 1e6
+    );
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let repeats = if quick { 3 } else { 15 };
+    bench_rk4_step(repeats);
+    bench_logging(
+        repeats,
+        "200 s generic tumble, dopri5 rtol 1e-12",
+        "dopri5",
+        None,
+    );
+    bench_logging(
+        repeats,
+        "200 s generic tumble, rk4 dt 1e-4",
+        "rk4",
+        Some(1e-4),
+    );
+}

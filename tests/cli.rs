@@ -1,0 +1,429 @@
+//! The command line as a user meets it: bad input, the run and its outputs, linearize, Ctrl-C.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn polhode() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_polhode"))
+}
+
+/// A fresh, empty scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("polhode-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+const GOOD: &str = "name: good
+body:
+  principal: [1.0, 2.0, 3.0]
+  spin_axis: [0, 0, 1]
+initial:
+  omega: [0.1, 0.0, 1.0]
+duration: 2.0
+integrator: {method: dopri5, rtol: 1.0e-10, atol: 1.0e-12}
+output: {rate: 10}
+";
+
+/// Writes `yaml` to DIR/bad.yaml, runs `polhode run` on it with the log going to DIR, and
+/// checks: exit code 2, one message naming file:line, the field and the expectation, no
+/// panic, and nothing written in DIR.
+fn assert_rejected(name: &str, yaml: &[u8], line: u32, field: &str, expect: &str) {
+    assert_rejected_at(name, yaml, line, Some(field), expect)
+}
+
+/// As [`assert_rejected`]; `field` is `None` for syntax errors, where no field is certain.
+fn assert_rejected_at(name: &str, yaml: &[u8], line: u32, field: Option<&str>, expect: &str) {
+    let dir = scratch(name);
+    let file = dir.join("bad.yaml");
+    std::fs::write(&file, yaml).unwrap();
+    let out = polhode()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.join("out.mcap"))
+        .arg("--summary")
+        .arg(dir.join("summary.json"))
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+    assert!(!err.contains("panicked"), "{name}: {err}");
+    let located = format!("{}:{line}:", file.display());
+    assert!(
+        err.contains(&located),
+        "{name}: expected {located} in: {err}"
+    );
+    if let Some(field) = field {
+        assert!(
+            err.contains(&format!("field `{field}`")),
+            "{name}: expected field {field} in: {err}"
+        );
+    }
+    assert!(
+        err.contains(expect),
+        "{name}: expected '{expect}' in: {err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{name}: one message: {err}");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| n != "bad.yaml")
+        .collect();
+    assert!(left.is_empty(), "{name}: files written: {left:?}");
+    // `check` agrees.
+    let chk = polhode().arg("check").arg(&file).output().unwrap();
+    assert_eq!(chk.status.code(), Some(2), "{name}: check");
+}
+
+#[test]
+fn malformed_yaml() {
+    let y = GOOD.replace("spin_axis: [0, 0, 1]", "spin_axis: [0, 0, 1");
+    assert_rejected_at("malformed", y.as_bytes(), 5, None, "");
+}
+
+#[test]
+fn unknown_key_suggests_the_nearest() {
+    let y = GOOD.replace("spin_axis:", "spin_axs:");
+    assert_rejected(
+        "unknown",
+        y.as_bytes(),
+        4,
+        "body.spin_axs",
+        "did you mean `spin_axis`?",
+    );
+    let y = GOOD.replace("method: dopri5", "method: dopri");
+    assert_rejected(
+        "method",
+        y.as_bytes(),
+        8,
+        "integrator.method",
+        "did you mean `dopri5`?",
+    );
+}
+
+#[test]
+fn wrong_types() {
+    let y = GOOD.replace("duration: 2.0", "duration: two seconds");
+    assert_rejected("type-duration", y.as_bytes(), 7, "duration", "");
+    let y = GOOD.replace("[1.0, 2.0, 3.0]", "[1.0, 2.0]");
+    assert_rejected("type-length", y.as_bytes(), 3, "body.principal", "length 3");
+}
+
+#[test]
+fn unphysical_inertia() {
+    let y = GOOD.replace("[1.0, 2.0, 3.0]", "[-1.0, 2.0, 3.0]");
+    assert_rejected(
+        "negative",
+        y.as_bytes(),
+        3,
+        "body.principal",
+        "positive definite",
+    );
+    let y = GOOD.replace("[1.0, 2.0, 3.0]", "[1.0, 1.0, 3.0]");
+    assert_rejected(
+        "triangle",
+        y.as_bytes(),
+        3,
+        "body.principal",
+        "triangle inequality",
+    );
+    let y = GOOD.replace(
+        "principal: [1.0, 2.0, 3.0]",
+        "inertia: [[1, 0.5, 0], [0, 2, 0], [0, 0, 2]]",
+    );
+    assert_rejected("asymmetric", y.as_bytes(), 3, "body.inertia", "symmetric");
+}
+
+#[test]
+fn non_finite_numbers() {
+    let y = GOOD.replace("omega: [0.1, 0.0, 1.0]", "omega: [.nan, 0.0, 1.0]");
+    assert_rejected("nan", y.as_bytes(), 6, "initial.omega", "finite");
+    let y = GOOD.replace("duration: 2.0", "duration: .inf");
+    assert_rejected("inf", y.as_bytes(), 7, "duration", "finite");
+    let y = GOOD.replace("[1.0, 2.0, 3.0]", "[1.0, .nan, 3.0]");
+    assert_rejected("nan-inertia", y.as_bytes(), 3, "body.principal", "finite");
+}
+
+#[test]
+fn non_positive_duration() {
+    for d in ["0", "-1.0"] {
+        let y = GOOD.replace("duration: 2.0", &format!("duration: {d}"));
+        assert_rejected(
+            &format!("duration{d}"),
+            y.as_bytes(),
+            7,
+            "duration",
+            "positive",
+        );
+    }
+}
+
+#[test]
+fn not_utf8() {
+    let mut y = GOOD.as_bytes().to_vec();
+    y.splice(0..0, b"# caf\xe9\n".iter().copied());
+    let dir = scratch("utf8");
+    let file = dir.join("bad.yaml");
+    std::fs::write(&file, &y).unwrap();
+    let out = polhode().arg("check").arg(&file).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains(":1:6:"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("UTF-8"));
+}
+
+#[test]
+fn unwritable_output_path() {
+    let dir = scratch("unwritable");
+    let file = dir.join("good.yaml");
+    std::fs::write(&file, GOOD).unwrap();
+    // A path under a regular file can never be created, whoever runs the test.
+    let blocker = dir.join("not-a-dir");
+    std::fs::write(&blocker, "x").unwrap();
+    let target = blocker.join("out.mcap");
+    let out = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            target.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains(&target.display().to_string()));
+    assert!(!target.exists());
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+}
+
+#[test]
+fn run_writes_log_and_summary() {
+    let dir = scratch("run");
+    let file = dir.join("good.yaml");
+    std::fs::write(&file, GOOD).unwrap();
+    let mcap = dir.join("good.mcap");
+    let summary = dir.join("summary.json");
+    let out = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            mcap.to_str().unwrap(),
+        ])
+        .args(["--summary", summary.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(mcap.exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    for key in [
+        "status",
+        "initial",
+        "final",
+        "drift",
+        "steps",
+        "rhs_evaluations",
+        "wall_time_s",
+        "events",
+        "samples",
+    ] {
+        assert!(json.get(key).is_some(), "summary lacks {key}");
+    }
+    let fin = &json["final"];
+    for key in [
+        "omega",
+        "q",
+        "kinetic_energy",
+        "h_norm",
+        "nutation_angle_deg",
+    ] {
+        assert!(fin.get(key).is_some(), "summary.final lacks {key}");
+    }
+    assert_eq!(fin["t"].as_f64(), Some(2.0));
+    assert_eq!(json["samples"].as_u64(), Some(21));
+    assert!(json["drift"]["h_norm_rel"].as_f64().unwrap() < 1e-9);
+    // The log holds what the summary says.
+    let bytes = std::fs::read(&mcap).unwrap();
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let stats = summary.stats.unwrap();
+    let per_channel: std::collections::HashMap<String, u64> = summary
+        .channels
+        .values()
+        .map(|c| (c.topic.clone(), stats.channel_message_counts[&c.id]))
+        .collect();
+    assert_eq!(per_channel["/tf"], 21);
+    assert_eq!(per_channel["/telemetry"], 21);
+    assert_eq!(per_channel["/scene"], 21);
+}
+
+#[test]
+fn overrides_from_the_command_line() {
+    let dir = scratch("overrides");
+    let file = dir.join("good.yaml");
+    std::fs::write(&file, GOOD).unwrap();
+    let summary = dir.join("s.json");
+    let out = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--no-log",
+            "--method",
+            "rk4",
+            "--dt",
+            "0.01",
+        ])
+        .args([
+            "--duration",
+            "3",
+            "--summary",
+            summary.to_str().unwrap(),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(out.stdout.is_empty());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(json["method"], "rk4");
+    assert_eq!(json["steps"].as_u64(), Some(300));
+    assert_eq!(json["rhs_evaluations"].as_u64(), Some(1200));
+    assert_eq!(json["final"]["t"].as_f64(), Some(3.0));
+}
+
+#[test]
+fn stop_event_ends_the_run_at_the_crossing() {
+    let dir = scratch("stop");
+    let summary = dir.join("s.json");
+    let out = polhode()
+        .args(["run", "scenarios/book.yaml", "--no-log", "--quiet"])
+        .args(["--summary", summary.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(json["status"]["kind"], "stopped");
+    let t = json["events"][0]["t"].as_f64().unwrap();
+    assert_eq!(json["final"]["t"].as_f64(), Some(t));
+    let nut = json["final"]["nutation_angle_deg"].as_f64().unwrap();
+    assert!((nut - 89.0).abs() < 1e-8, "stopped at {nut}°");
+}
+
+#[test]
+fn linearize_reproduces_k_for_the_tennis_racket() {
+    let out = polhode()
+        .args(["linearize", "scenarios/tennis-racket.yaml", "--json", "-"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let k = json["max_growth_rate"].as_f64().unwrap();
+    assert!((k - 5.0).abs() < 1e-8, "k = {k}");
+    assert_eq!(json["verdict"], "unstable");
+    let text = polhode()
+        .args(["linearize", "scenarios/tennis-racket.yaml"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("time constant 0.200000 s"), "{text}");
+}
+
+#[test]
+fn every_shipped_scenario_is_valid() {
+    let mut files: Vec<PathBuf> = std::fs::read_dir("scenarios")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "yaml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 5);
+    let out = polhode().arg("check").args(&files).output().unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// Ctrl-C mid-run: exit 130, a valid finished MCAP of what was computed, marked partial.
+#[test]
+#[cfg(unix)]
+fn interrupt_keeps_a_valid_partial_log() {
+    let dir = scratch("sigint");
+    let file = dir.join("long.yaml");
+    std::fs::write(
+        &file,
+        GOOD.replace("duration: 2.0", "duration: 1.0e6").replace(
+            "method: dopri5, rtol: 1.0e-10, atol: 1.0e-12",
+            "method: rk4, dt: 1.0e-4",
+        ),
+    )
+    .unwrap();
+    let mcap = dir.join("long.mcap");
+    let mut child = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            mcap.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait until the run is under way (its temporary file exists), then interrupt.
+    let started = std::time::Instant::now();
+    while !std::fs::read_dir(&dir)
+        .unwrap()
+        .any(|e| e.unwrap().file_name().to_string_lossy().ends_with(".tmp"))
+    {
+        assert!(started.elapsed().as_secs() < 30, "run did not start");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{}", stderr(&out));
+    assert!(stderr(&out).contains("partial"), "{}", stderr(&out));
+    assert_partial_log_is_valid(&mcap);
+    let leftovers = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".tmp")
+        })
+        .count();
+    assert_eq!(leftovers, 0);
+}
+
+fn assert_partial_log_is_valid(path: &Path) {
+    let bytes = std::fs::read(path).unwrap();
+    let mut n = 0;
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        m.unwrap();
+        n += 1;
+    }
+    assert!(n > 3, "only {n} messages");
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let index = summary
+        .metadata_indexes
+        .iter()
+        .find(|i| i.name == "polhode")
+        .expect("metadata");
+    let meta = mcap::read::metadata(&bytes, index).unwrap();
+    assert_eq!(meta.metadata["status"], "interrupted (partial)");
+}

@@ -1,0 +1,68 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use polhode::model::Observation;
+use polhode::scenario::{self, Overrides, Scenario};
+use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// A sink that keeps every sample and event in memory.
+#[derive(Default)]
+pub struct Recorder {
+    pub samples: Vec<Observation>,
+    pub events: Vec<EventRecord>,
+}
+
+impl Sink for Recorder {
+    fn sample(&mut self, o: &Observation, _y: &[f64], _inv: &Reference) -> std::io::Result<()> {
+        self.samples.push(o.clone());
+        Ok(())
+    }
+    fn event(&mut self, e: &EventRecord, _o: &Observation) -> std::io::Result<()> {
+        self.events.push(e.clone());
+        Ok(())
+    }
+}
+
+/// Parses a scenario from YAML text.
+pub fn scenario(yaml: &str) -> Scenario {
+    scenario_with(yaml, &Overrides::default())
+}
+
+/// Parses a scenario from YAML text with overrides.
+pub fn scenario_with(yaml: &str, ov: &Overrides) -> Scenario {
+    scenario::parse(Path::new("test.yaml"), yaml.to_string(), ov)
+        .unwrap_or_else(|e| panic!("test scenario invalid: {e}"))
+}
+
+/// Runs a scenario, keeping samples and events.
+pub fn run(s: &Scenario) -> (Outcome, Recorder) {
+    let mut rec = Recorder::default();
+    let stop = AtomicBool::new(false);
+    let out = sim::run(
+        s,
+        &mut rec,
+        Control {
+            interrupt: &stop,
+            progress: None,
+        },
+    )
+    .expect("in-memory sink cannot fail");
+    (out, rec)
+}
+
+/// A rigid-body scenario in YAML from its parts.
+pub fn rigid_yaml(
+    principal: [f64; 3],
+    omega: [f64; 3],
+    duration: f64,
+    integrator: &str,
+    extra: &str,
+) -> String {
+    format!(
+        "name: t\nbody: {{principal: [{}, {}, {}]}}\ninitial: {{omega: [{:e}, {:e}, {:e}]}}\n\
+         duration: {duration:e}\nintegrator: {integrator}\noutput: {{rate: 10}}\n{extra}",
+        principal[0], principal[1], principal[2], omega[0], omega[1], omega[2]
+    )
+}
