@@ -768,7 +768,10 @@ impl ScenarioFile {
                 return Err(err(
                     loc(r),
                     "output.scene_rate",
-                    format!("expected a positive number of updates per second, got {}", r.value),
+                    format!(
+                        "expected a positive number of updates per second, got {}",
+                        r.value
+                    ),
                 ));
             }
         };
