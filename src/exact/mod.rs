@@ -21,7 +21,7 @@ use std::fmt;
 
 use nalgebra::{Matrix3, Quaternion, Rotation3, SymmetricEigen, Unit, UnitQuaternion, Vector3};
 
-use elliptic::{carlson_rj, inverse_sncndn, is_odd, Jacobi};
+use elliptic::{Jacobi, carlson_rj, inverse_sncndn, is_odd};
 
 /// Two principal moments whose difference is at most this fraction of the largest moment are
 /// treated as equal (axisymmetric body; all three: spherical). Dimensionless.
@@ -115,7 +115,7 @@ impl std::error::Error for ExactError {}
 ///
 /// Build once with [`TorqueFreeSolution::new`], then evaluate at any time (negative and large
 /// times included) with [`TorqueFreeSolution::state_at`]; everything that does not depend on
-/// t is precomputed. Cost per `state_at` call is about a microsecond.
+/// t is precomputed. A `state_at` call costs about 0.6 µs (elliptic case).
 #[derive(Debug, Clone)]
 pub struct TorqueFreeSolution {
     regime: Regime,
@@ -336,6 +336,9 @@ fn principal_decomposition(j: &Matrix3<f64>) -> ([f64; 3], Matrix3<f64>) {
             *c = -*c;
         }
     }
+    // Re-orthonormalise (Gram–Schmidt) so that P is a rotation to rounding level.
+    cols[0] = cols[0].normalize();
+    cols[1] = (cols[1] - cols[0] * cols[0].dot(&cols[1])).normalize();
     let p = Matrix3::from_columns(&[cols[0], cols[1], cols[0].cross(&cols[1])]);
     ([vals[idx[0]], vals[idx[1]], vals[idx[2]]], p)
 }

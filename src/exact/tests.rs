@@ -583,6 +583,33 @@ fn regimes_and_degenerate_cases() {
 }
 
 #[test]
+fn principal_axes_convention() {
+    let q0 = some_attitude();
+    let w0 = Vector3::new(0.1, 0.2, 0.3);
+    let sol = TorqueFreeSolution::new(&diag(2.0, 1.0, 3.0), &w0, &q0).unwrap();
+    assert_eq!(sol.principal_moments(), Vector3::new(1.0, 2.0, 3.0));
+    let p = sol.principal_axes();
+    assert_eq!(
+        p,
+        Matrix3::new(0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0)
+    );
+    let r = UnitQuaternion::from_euler_angles(0.7, 0.2, -1.3);
+    let j = rotated_inertia([3.0, 1.0, 2.0], &r);
+    let sol = TorqueFreeSolution::new(&j, &w0, &q0).unwrap();
+    let (m, p) = (sol.principal_moments(), sol.principal_axes());
+    for i in 0..3 {
+        let res = (j * p.column(i) - p.column(i) * m[i]).norm();
+        assert!(res < 8.0 * f64::EPSILON * 3.0, "{res:e}");
+    }
+    let (det, orth) = (
+        p.determinant(),
+        (p.transpose() * p - Matrix3::identity()).norm(),
+    );
+    assert!((det - 1.0).abs() < 4.0 * f64::EPSILON, "{det}");
+    assert!(orth < 4.0 * f64::EPSILON, "{orth:e}");
+}
+
+#[test]
 fn large_and_tiny_rates() {
     // The scaling by powers of two keeps extreme magnitudes finite and exact.
     let j = diag(1.0, 2.0, 3.0);
