@@ -367,7 +367,7 @@ fn interrupt_keeps_a_valid_partial_log() {
     )
     .unwrap();
     let mcap = dir.join("long.mcap");
-    let mut child = polhode()
+    let child = polhode()
         .args([
             "run",
             file.to_str().unwrap(),

@@ -88,9 +88,9 @@ fn flip_interval_matches_elliptic_half_period() {
 /// ln|ω1| while the motion is still linear), it must match within 1%.
 #[test]
 fn growth_rate_measured_from_a_flip_matches_k() {
-    for (principal, spin) in [([1.0, 2.0, 3.0], 1.0), ([1.0, 2.5, 3.0], 10.0)] {
-        let [i1, i2, i3] = principal;
-        let k = spin * ((i3 - i2) * (i2 - i1) / (i1 * i3) as f64).sqrt();
+    for (principal, spin) in [([1.0, 2.0, 3.0], 1.0f64), ([1.0, 2.5, 3.0], 10.0)] {
+        let [i1, i2, i3]: [f64; 3] = principal;
+        let k = spin * ((i3 - i2) * (i2 - i1) / (i1 * i3)).sqrt();
         let duration = 30.0 / k;
         let s = scenario(&rigid_yaml(
             principal,
