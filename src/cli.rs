@@ -388,6 +388,7 @@ struct Summary<'a> {
     scenario_file: String,
     method: &'static str,
     method_settings: String,
+    body: Body,
     status: &'a Status,
     mcap: Option<String>,
     initial: State,
@@ -400,6 +401,32 @@ struct Summary<'a> {
     samples: u64,
     wall_time_s: f64,
     events: &'a [sim::EventRecord],
+}
+
+/// Mass properties as polhode computed them.
+#[derive(serde::Serialize)]
+struct Body {
+    /// Principal moments, ascending (kg m²).
+    principal_moments: [f64; 3],
+    /// Unit principal axes in body coordinates, in the order of the moments.
+    principal_axes: [[f64; 3]; 3],
+    /// Unit spin axis (body) whose nutation angle is reported.
+    spin_axis: [f64; 3],
+}
+
+fn body(s: &Scenario) -> Body {
+    let hub = &s.spacecraft.hub;
+    let axis = |c: usize| {
+        let a = hub.principal_axes.column(c);
+        [a[0], a[1], a[2]]
+    };
+    let p = hub.principal_moments;
+    let sa = s.spacecraft.spin_axis;
+    Body {
+        principal_moments: [p[0], p[1], p[2]],
+        principal_axes: [axis(0), axis(1), axis(2)],
+        spin_axis: [sa[0], sa[1], sa[2]],
+    }
 }
 
 #[derive(serde::Serialize)]
@@ -445,6 +472,7 @@ fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         scenario_file: s.path.display().to_string(),
         method: s.method.name(),
         method_settings: s.method.describe(),
+        body: body(s),
         status: &o.status,
         mcap: mcap.map(|p| p.display().to_string()),
         initial: state(&o.initial_observation),
@@ -464,6 +492,21 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     let f = &o.final_observation;
     let q = f.attitude;
     println!("{} — {}", s.name, s.method.describe());
+    let b = body(s);
+    let m = b.principal_moments;
+    println!(
+        "  principal moments {:.9e}, {:.9e}, {:.9e} kg m²",
+        m[0], m[1], m[2]
+    );
+    for (i, a) in b.principal_axes.iter().enumerate() {
+        println!(
+            "    axis {}: [{:+.9}, {:+.9}, {:+.9}]",
+            i + 1,
+            a[0],
+            a[1],
+            a[2]
+        );
+    }
     println!(
         "  status: {}{}",
         o.status.label(),

@@ -228,6 +228,7 @@ fn run_writes_log_and_summary() {
         serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
     for key in [
         "status",
+        "body",
         "initial",
         "final",
         "drift",
