@@ -354,6 +354,8 @@ fn drive<M: Stepper>(
 
     let mut prev = o0.clone();
     let mut last_obs = o0.clone();
+    // Set when the state went non-finite: the time of the last finite state (held in `buf`).
+    let mut last_good: Option<f64> = None;
     let mut last_poll = Instant::now();
     while status.is_none() && stepper.t() < t_end {
         if stepper.stats().steps.is_multiple_of(POLL_STEPS) {
@@ -377,9 +379,16 @@ fn drive<M: Stepper>(
         }
         let t1 = stepper.t();
         if !stepper.y().iter().all(|v| v.is_finite()) {
+            // Report the last finite state: the start of the failed step.
+            let t_good = stepper.t_prev();
+            stepper.interpolate(t_good, &mut buf);
+            let what = format!(
+                "the state became non-finite in the step from t = {t_good} s to t = {t1} s"
+            );
             status = Some(Status::Failed {
-                diagnosis: diagnose("the state became non-finite", t1, stepper.y(), scenario),
+                diagnosis: diagnose(&what, t_good, &buf, scenario),
             });
+            last_good = Some(t_good);
             break;
         }
         inv.update(&mut drift, &sc.invariants(t1, stepper.y()));
@@ -480,12 +489,14 @@ fn drive<M: Stepper>(
     }
     let status = status.unwrap_or(Status::Completed);
     // The last instant reached is always logged, on the grid or not.
-    let final_state = if matches!(status, Status::Stopped { .. }) {
+    let final_state = if matches!(status, Status::Stopped { .. }) || last_good.is_some() {
         buf.clone()
     } else {
         stepper.y().to_vec()
     };
-    if !matches!(status, Status::Stopped { .. }) {
+    if let Some(t_good) = last_good {
+        last_obs = sc.observe(t_good, &buf);
+    } else if !matches!(status, Status::Stopped { .. }) {
         let o = sc.observe(stepper.t(), stepper.y());
         if stepper.t() > last_sample_t && stepper.y().iter().all(|v| v.is_finite()) {
             sink.sample(&o, stepper.y(), &inv)?;
@@ -555,6 +566,7 @@ fn locate<M: Stepper>(
 /// A diagnosis for a failed integration: what, when, the state, and what to try.
 fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
     let state: Vec<String> = y.iter().take(7).map(|v| format!("{v:.6e}")).collect();
+    // `t` and `y` are the last finite state known.
     let remedy = match scenario.method {
         Method::Rk4 { dt } => format!(
             "the fixed step dt = {dt:e} s may exceed the stability limit of rk4 for this \
@@ -567,7 +579,7 @@ fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         Method::Exact => "report this as a bug with the scenario attached".into(),
     };
     format!(
-        "{what} at t = {t} s; state [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
         state.join(", ")
     )
 }

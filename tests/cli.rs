@@ -428,3 +428,57 @@ fn assert_partial_log_is_valid(path: &Path) {
     let meta = mcap::read::metadata(&bytes, index).unwrap();
     assert_eq!(meta.metadata["status"], "interrupted (partial)");
 }
+
+/// An explicit method far above its stability limit: the run stops with a diagnosis (time,
+/// last finite state, remedy), exit 3, and keeps a valid log marked partial, never NaNs.
+#[test]
+fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
+    let dir = scratch("unstable");
+    let file = dir.join("unstable.yaml");
+    std::fs::write(
+        &file,
+        GOOD.replace("omega: [0.1, 0.0, 1.0]", "omega: [30.0, 50.0, 80.0]")
+            .replace("duration: 2.0", "duration: 100.0")
+            .replace(
+                "method: dopri5, rtol: 1.0e-10, atol: 1.0e-12",
+                "method: rk4, dt: 0.5",
+            ),
+    )
+    .unwrap();
+    let mcap = dir.join("unstable.mcap");
+    let summary = dir.join("s.json");
+    let out = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            mcap.to_str().unwrap(),
+        ])
+        .args(["--summary", summary.to_str().unwrap(), "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("non-finite in the step from t = "), "{err}");
+    assert!(err.contains("stability limit"), "{err}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    assert_eq!(json["status"]["kind"], "failed");
+    let w = json["final"]["omega"].as_array().unwrap();
+    assert!(
+        w.iter().all(|v| v.as_f64().is_some_and(f64::is_finite)),
+        "{w:?}"
+    );
+    let bytes = std::fs::read(&mcap).unwrap();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        m.unwrap();
+    }
+    let s = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let index = s
+        .metadata_indexes
+        .iter()
+        .find(|i| i.name == "polhode")
+        .unwrap();
+    let meta = mcap::read::metadata(&bytes, index).unwrap();
+    assert_eq!(meta.metadata["status"], "failed (partial)");
+}

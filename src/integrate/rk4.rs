@@ -138,8 +138,13 @@ impl Stepper for Rk4 {
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
-        if h == 0.0 {
+        // The step's ends are returned as stored (also when the stages overflowed).
+        if h == 0.0 || t == self.t {
             out.copy_from_slice(&self.y);
+            return;
+        }
+        if t == self.t_prev {
+            out.copy_from_slice(&self.y_prev);
             return;
         }
         let th = (t - self.t_prev) / h;
