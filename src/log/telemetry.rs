@@ -6,11 +6,11 @@
 
 use crate::model::Observation;
 use crate::sim::Reference;
-use foxglove::prost_types::{
+use prost::Message;
+use prost_types::{
     DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet,
     field_descriptor_proto::{Label, Type},
 };
-use prost::Message;
 
 /// Fully qualified schema name.
 pub const SCHEMA_NAME: &str = "polhode.Telemetry";
