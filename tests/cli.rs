@@ -108,6 +108,39 @@ fn unknown_key_suggests_the_nearest() {
 }
 
 #[test]
+fn missing_keys_name_the_missing_field() {
+    let y = GOOD.replace("duration: 2.0\n", "");
+    assert_rejected("missing-duration", y.as_bytes(), 8, "duration", "required");
+    let y = GOOD.replace(
+        "  omega: [0.1, 0.0, 1.0]",
+        "  omega: [0.1, 0.0, 1.0]\n  attitude: {w: 1.0, x: 0.0, y: 0.0}",
+    );
+    assert_rejected(
+        "missing-z",
+        y.as_bytes(),
+        7,
+        "initial.attitude.z",
+        "required",
+    );
+}
+
+#[test]
+fn empty_file_and_non_mapping() {
+    let dir = scratch("empty");
+    for (name, text) in [("empty.yaml", "# nothing\n"), ("list.yaml", "- a\n- b\n")] {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        let out = polhode().arg("check").arg(&file).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        assert!(
+            stderr(&out).contains("expected a mapping of scenario keys"),
+            "{}",
+            stderr(&out)
+        );
+    }
+}
+
+#[test]
 fn wrong_types() {
     let y = GOOD.replace("duration: 2.0", "duration: two seconds");
     assert_rejected("type-duration", y.as_bytes(), 7, "duration", "");

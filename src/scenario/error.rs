@@ -96,8 +96,20 @@ pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
         }
         stack.push((indent, key.to_string()));
         if number == line {
-            // Inside a value on this line: find the innermost inline key before the column.
-            let upto: String = raw.chars().take(column as usize).collect();
+            // Inside a value on this line: find the innermost inline key up to the column,
+            // including a key that starts at the column itself.
+            let chars: Vec<char> = raw.chars().collect();
+            let start = (column as usize).saturating_sub(1).min(chars.len());
+            let mut end = start;
+            while end < chars.len() && !matches!(chars[end], ':' | ',' | '}' | ']') {
+                end += 1;
+            }
+            let take = if chars.get(end) == Some(&':') {
+                end + 1
+            } else {
+                start
+            };
+            let upto: String = chars[..take].iter().collect();
             let after_key = upto.split_once(':').map(|x| x.1).unwrap_or("");
             if let Some(k) = last_inline_key(after_key) {
                 stack.push((usize::MAX, k));
@@ -156,6 +168,8 @@ mod tests {
         assert_eq!(field_path_at(YAML, 4, 3), "body.spin_axs");
         assert_eq!(field_path_at(YAML, 3, 17), "body.principal");
         assert_eq!(field_path_at(YAML, 6, 33), "initial.attitude.q");
+        // A key that starts at the column (serde-saphyr points there for missing fields).
+        assert_eq!(field_path_at(YAML, 6, 23), "initial.attitude.x");
         assert_eq!(field_path_at(YAML, 8, 5), "stop.nutation_angle_deg");
         assert_eq!(field_path_at(YAML, 1, 1), "name");
     }

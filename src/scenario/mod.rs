@@ -471,8 +471,26 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
     {
         message = rest.to_string();
     }
+    // The location is printed in front; drop the library's copy at the end.
+    if let Some(i) = message.rfind(" at line ")
+        && message[i..].contains(", column ")
+    {
+        message.truncate(i);
+    }
     if message.is_empty() {
         message = "invalid YAML".into();
+    }
+    const TOP_LEVEL: &str = "expected a mapping of scenario keys (`name`, `body`, `initial`, \
+                             `duration`, ...)";
+    if source
+        .trim()
+        .lines()
+        .all(|l| l.trim().is_empty() || l.trim().starts_with('#'))
+    {
+        return ScenarioError::at(path, None, "", format!("the file is empty: {TOP_LEVEL}"));
+    }
+    if message.contains("expected mapping start") && location.is_some_and(|l| l.0 == 1) {
+        message = format!("the document is not a mapping: {TOP_LEVEL}");
     }
     // "unknown field `x`, expected one of a, b" → suggest the nearest valid name.
     if message.starts_with("unknown")
@@ -487,9 +505,22 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
             message = format!("{message}; did you mean `{best}`?");
         }
     }
-    let field = location
+    let mut field = location
         .map(|(l, c)| field_path_at(source, l, c))
         .unwrap_or_default();
+    // "missing field `x`": the location is a sibling key, so the field is its parent's `x`.
+    if let Some(missing) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.split('`').next())
+    {
+        let parent = field.rsplit_once('.').map(|(p, _)| p).unwrap_or("");
+        field = if parent.is_empty() {
+            missing.to_string()
+        } else {
+            format!("{parent}.{missing}")
+        };
+        message = format!("{message}: this key is required");
+    }
     ScenarioError::at(path, location, field, message)
 }
 
