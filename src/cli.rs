@@ -248,6 +248,14 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// Whether two paths name the same file (compared as absolute paths; neither need exist).
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::path::absolute(a), std::path::absolute(b)) {
+        (Ok(a), Ok(b)) => a == b || a.canonicalize().ok() == Some(b.clone()),
+        _ => a == b,
+    }
+}
+
 /// Checks up front that a file can be created at `path` (without leaving one behind).
 fn probe_writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
@@ -273,6 +281,16 @@ fn run(
         Ok(s) => s,
         Err(c) => return c,
     };
+    if let Some(p) = summary_path
+        && !no_log
+        && same_file(p, &s.mcap_path)
+    {
+        eprintln!(
+            "error: --summary {} is the log's own path; give the summary another name",
+            p.display()
+        );
+        return EXIT_BAD_INPUT;
+    }
     if let Some(p) = summary_path
         && let Err(e) = probe_writable(p)
     {

@@ -128,11 +128,21 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let eig = jac.clone().complex_eigenvalues();
     let scale = spin_rate.abs();
     let zero = 1e-9 * scale;
+    // One zero eigenvalue belongs to the spin itself (a change of spin rate is steady too).
+    // Further zero eigenvalues make the linearisation degenerate (e.g. a symmetric body spun
+    // about a transverse axis): they are `neutral`, and the verdict says the linear theory
+    // cannot decide.
+    let mut spin_seen = false;
     let mut modes: Vec<Mode> = eig
         .iter()
         .map(|z| {
             let kind = if z.norm() <= zero {
-                "spin"
+                if spin_seen {
+                    "neutral"
+                } else {
+                    spin_seen = true;
+                    "spin"
+                }
             } else if z.re > zero {
                 "growing"
             } else if z.re < -zero {
@@ -155,9 +165,14 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         .iter()
         .filter(|m| m.kind != "spin")
         .map(|m| m.re)
-        .fold(f64::NEG_INFINITY, f64::max);
+        .reduce(f64::max)
+        .unwrap_or(0.0);
+    let degenerate = modes.iter().any(|m| m.kind == "neutral");
     let verdict = if max_growth_rate > zero {
         "unstable"
+    } else if degenerate {
+        "inconclusive: repeated zero eigenvalues (a symmetric body spun about a transverse \
+         axis, or a sphere); the linearisation cannot decide stability"
     } else if max_growth_rate < -zero {
         "asymptotically stable"
     } else {
@@ -243,6 +258,20 @@ mod tests {
                 max_relative = 1e-12
             );
         }
+    }
+
+    #[test]
+    fn repeated_zero_eigenvalues_are_inconclusive() {
+        // I = (1, 1, 1.5) spun about x: the Jacobian is nilpotent (all eigenvalues 0).
+        let sc = Spacecraft::new(
+            RigidBody::from_principal([1.0, 1.0, 1.5]).unwrap(),
+            Vector3::x(),
+        );
+        let lin = linearize(&sc, 2.0).unwrap();
+        assert!(lin.verdict.starts_with("inconclusive"), "{}", lin.verdict);
+        assert_eq!(lin.modes.iter().filter(|m| m.kind == "spin").count(), 1);
+        assert!(lin.max_growth_rate.is_finite());
+        assert_eq!(lin.time_constant, None);
     }
 
     #[test]

@@ -328,6 +328,7 @@ fn drive<M: Stepper>(
         .chain(scenario.events.iter().map(|c| (c, false)))
         .collect();
 
+    buf.copy_from_slice(stepper.y());
     sink.sample(&o0, stepper.y(), &inv)?;
     let mut samples = 1u64;
     let mut next_k = 1u64;
@@ -496,6 +497,10 @@ fn drive<M: Stepper>(
     };
     if let Some(t_good) = last_good {
         last_obs = sc.observe(t_good, &buf);
+        if t_good > last_sample_t {
+            sink.sample(&last_obs, &buf, &inv)?;
+            samples += 1;
+        }
     } else if !matches!(status, Status::Stopped { .. }) {
         let o = sc.observe(stepper.t(), stepper.y());
         if stepper.t() > last_sample_t && stepper.y().iter().all(|v| v.is_finite()) {
@@ -532,7 +537,8 @@ fn locate<M: Stepper>(
     mut gb: f64,
     buf: &mut [f64],
 ) -> f64 {
-    let tol = 1e-13 * b.abs().max(1.0);
+    // Relative to the time itself (documented as ~1e-13 relative), never below a few ulps.
+    let tol = (1e-13 * a.abs().max(b.abs())).max(4.0 * f64::EPSILON * b.abs());
     let mut side = 0i8;
     for _ in 0..200 {
         if (b - a).abs() <= tol {

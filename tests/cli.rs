@@ -514,4 +514,89 @@ fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
         .unwrap();
     let meta = mcap::read::metadata(&bytes, index).unwrap();
     assert_eq!(meta.metadata["status"], "failed (partial)");
+    // The last finite state is the log's last sample: /telemetry field 1 is sim_time, a
+    // protobuf double (key 0x09, then 8 bytes little-endian).
+    let telemetry = s
+        .channels
+        .values()
+        .find(|c| c.topic == "/telemetry")
+        .unwrap()
+        .id;
+    let last = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .map(|m| m.unwrap())
+        .filter(|m| m.channel.id == telemetry)
+        .last()
+        .unwrap();
+    assert_eq!(last.data[0], 0x09);
+    let sim_time = f64::from_le_bytes(last.data[1..9].try_into().unwrap());
+    assert_eq!(Some(sim_time), json["final"]["t"].as_f64());
+}
+
+/// Errors caused by a command-line option name the option, not a line of the file.
+#[test]
+fn option_errors_name_the_option() {
+    let dir = scratch("options");
+    let file = dir.join("good.yaml");
+    std::fs::write(&file, GOOD).unwrap();
+    for (args, field) in [
+        (vec!["--duration", "nan"], "--duration"),
+        (vec!["--method", "dopri6"], "--method"),
+        (vec!["--method", "rk4", "--dt=-1"], "--dt"),
+        (vec!["--duration", "1e9"], "--duration"),
+    ] {
+        let out = polhode()
+            .args(["run", file.to_str().unwrap(), "--no-log"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(&format!("field `{field}`")), "{args:?}: {err}");
+        let blames_a_line = err
+            .split("good.yaml:")
+            .nth(1)
+            .is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit()));
+        assert!(!blames_a_line, "{args:?} blames a line: {err}");
+    }
+}
+
+/// Requests that would run for ever or overflow the log's time stamps are refused up front.
+#[test]
+fn unbounded_work_and_unstampable_times_are_refused() {
+    let y = GOOD.replace(
+        "method: dopri5, rtol: 1.0e-10, atol: 1.0e-12",
+        "method: dopri5, max_step: 1.0e-17",
+    );
+    assert_rejected(
+        "max-step",
+        y.as_bytes(),
+        8,
+        "integrator.max_step",
+        "limit is 1e11",
+    );
+    let y = format!("epoch: \"2100-01-01T00:00:00Z\"\n{}", GOOD)
+        .replace("duration: 2.0", "duration: 3.0e8")
+        .replace("rate: 10", "rate: 1.0e-3");
+    assert_rejected("late", y.as_bytes(), 8, "duration", "2106-02-07");
+}
+
+#[test]
+fn summary_and_log_must_differ() {
+    let dir = scratch("same");
+    let file = dir.join("good.yaml");
+    std::fs::write(&file, GOOD).unwrap();
+    let target = dir.join("x.out");
+    let out = polhode()
+        .args([
+            "run",
+            file.to_str().unwrap(),
+            "--out",
+            target.to_str().unwrap(),
+        ])
+        .args(["--summary", target.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(!target.exists());
 }

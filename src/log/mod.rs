@@ -29,7 +29,7 @@ pub const BODY_FRAME: &str = "body";
 /// Writes one run to an MCAP file.
 pub struct McapLogger {
     writer: mcap::Writer<BufWriter<File>>,
-    temp_path: PathBuf,
+    temp: TempFile,
     final_path: PathBuf,
     epoch_ns: u64,
     channels: Channels,
@@ -43,6 +43,29 @@ struct Channels {
     scene: u16,
     telemetry: u16,
     log: u16,
+}
+
+/// A temporary file that is removed when dropped (on errors and panics alike) unless it was
+/// kept by renaming it to its final name.
+struct TempFile {
+    path: PathBuf,
+    keep: bool,
+}
+
+impl TempFile {
+    fn persist(mut self, to: &Path) -> io::Result<()> {
+        std::fs::rename(&self.path, to)?;
+        self.keep = true;
+        Ok(())
+    }
+}
+
+impl Drop for TempFile {
+    fn drop(&mut self) {
+        if !self.keep {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
 }
 
 /// Static drawing parameters, fixed at the start of the run.
@@ -90,8 +113,11 @@ impl McapLogger {
             .file_name()
             .map(|f| f.to_string_lossy().into_owned())
             .unwrap_or_else(|| "run.mcap".into());
-        let temp_path = dir.join(format!(".{file_name}.{}.tmp", std::process::id()));
-        let file = File::create(&temp_path)?;
+        let temp = TempFile {
+            path: dir.join(format!(".{file_name}.{}.tmp", std::process::id())),
+            keep: false,
+        };
+        let file = File::create(&temp.path)?;
         let options = mcap::WriteOptions::new()
             .compression(match scenario.compression {
                 Compression::Lz4 => Some(mcap::Compression::Lz4),
@@ -125,13 +151,7 @@ impl McapLogger {
                 },
             ))
         })();
-        let (writer, channels) = match result {
-            Ok(x) => x,
-            Err(e) => {
-                let _ = std::fs::remove_file(&temp_path);
-                return Err(e);
-            }
-        };
+        let (writer, channels) = result?;
         let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
         let size = match &scenario.shape {
             Shape::Box { size, .. } => size.max(),
@@ -139,7 +159,7 @@ impl McapLogger {
         };
         Ok(McapLogger {
             writer,
-            temp_path,
+            temp,
             final_path: path.to_path_buf(),
             epoch_ns: scenario.epoch_unix_ns,
             channels,
@@ -161,8 +181,11 @@ impl McapLogger {
         &self.final_path
     }
 
+    /// Log time (Unix ns) of sim time `t`. Validation keeps epoch + duration below 2^32 s,
+    /// so this neither overflows nor saturates for `0 ≤ t ≤ duration`.
     fn log_time(&self, t: f64) -> u64 {
-        self.epoch_ns + (t * 1e9).round() as u64
+        self.epoch_ns
+            .saturating_add((t.max(0.0) * 1e9).round() as u64)
     }
 
     fn timestamp(&self, t: f64) -> fg::Timestamp {
@@ -267,31 +290,24 @@ impl McapLogger {
             .map_err(io_err)?;
         let McapLogger {
             mut writer,
-            temp_path,
+            temp,
             final_path,
             ..
         } = self;
-        let result = (|| {
-            writer.finish().map_err(io_err)?;
-            let file = writer
-                .into_inner()
-                .into_inner()
-                .map_err(|e| e.into_error())?;
-            file.sync_all()?;
-            std::fs::rename(&temp_path, &final_path)
-        })();
-        match result {
-            Ok(()) => Ok(final_path),
-            Err(e) => {
-                let _ = std::fs::remove_file(&temp_path);
-                Err(e)
-            }
-        }
+        writer.finish().map_err(io_err)?;
+        let file = writer
+            .into_inner()
+            .into_inner()
+            .map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        // On any error above, dropping `temp` removes the unfinished file.
+        temp.persist(&final_path)?;
+        Ok(final_path)
     }
 
     /// Removes the temporary file (after an error that leaves nothing worth keeping).
     pub fn abandon(self) {
-        let _ = std::fs::remove_file(&self.temp_path);
+        drop(self);
     }
 
     fn scene_update(&self, o: &Observation) -> fg::SceneUpdate {

@@ -9,7 +9,7 @@ mod error;
 mod time;
 
 pub use error::{ScenarioError, field_path_at, nearest};
-pub use time::{format_epoch, parse_epoch};
+pub use time::{LAST_LOG_SECOND, format_epoch, parse_epoch};
 
 use crate::model::{RigidBody, Spacecraft};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
@@ -675,12 +675,24 @@ impl ScenarioFile {
             }
         };
 
+        // Where a value came from: a command-line option (no line; the option is named) or the
+        // file (its line and field).
+        let from = |option: Option<f64>, l: Option<(u32, u32)>, field: &'static str, flag| {
+            if option.is_some() {
+                (None, flag)
+            } else {
+                (l, field)
+            }
+        };
+
         // Duration.
         let duration = ov.duration.unwrap_or(self.duration.value);
+        let (duration_loc, duration_field) =
+            from(ov.duration, loc(&self.duration), "duration", "--duration");
         if !(duration.is_finite() && duration > 0.0) {
             return Err(err(
-                loc(&self.duration),
-                "duration",
+                duration_loc,
+                duration_field,
                 format!("expected a positive, finite number of seconds, got {duration}"),
             ));
         }
@@ -693,23 +705,43 @@ impl ScenarioFile {
             .clone()
             .or(spec.method.as_ref().map(|m| m.value.clone()))
             .unwrap_or_else(|| "dopri5".into());
-        let positive = |v: Option<f64>, s: &Option<Spanned<f64>>, field: &str, what: &str| match v
-            .or(s.as_ref().map(|x| x.value))
-        {
-            None => Ok(None),
-            Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
-            Some(x) => Err(err(
-                s.as_ref().and_then(loc),
-                field,
-                format!("expected a positive, finite {what}, got {x}"),
-            )),
+        let positive = |v: Option<f64>,
+                        s: &Option<Spanned<f64>>,
+                        field: &'static str,
+                        flag: &'static str,
+                        what: &str| {
+            match v.or(s.as_ref().map(|x| x.value)) {
+                None => Ok(None),
+                Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
+                Some(x) => {
+                    let (l, f) = from(v, s.as_ref().and_then(loc), field, flag);
+                    Err(err(
+                        l,
+                        f,
+                        format!("expected a positive, finite {what}, got {x}"),
+                    ))
+                }
+            }
         };
-        let dt = positive(ov.dt, &spec.dt, "integrator.dt", "step in seconds")?;
-        let rtol = positive(ov.rtol, &spec.rtol, "integrator.rtol", "relative tolerance")?;
-        let atol = positive(ov.atol, &spec.atol, "integrator.atol", "absolute tolerance")?;
+        let dt = positive(ov.dt, &spec.dt, "integrator.dt", "--dt", "step in seconds")?;
+        let rtol = positive(
+            ov.rtol,
+            &spec.rtol,
+            "integrator.rtol",
+            "--rtol",
+            "relative tolerance",
+        )?;
+        let atol = positive(
+            ov.atol,
+            &spec.atol,
+            "integrator.atol",
+            "--atol",
+            "absolute tolerance",
+        )?;
         let max_step = positive(
             None,
             &spec.max_step,
+            "integrator.max_step",
             "integrator.max_step",
             "step in seconds",
         )?;
@@ -733,9 +765,14 @@ impl ScenarioFile {
                 let hint = nearest(other, Method::NAMES)
                     .map(|b| format!("; did you mean `{b}`?"))
                     .unwrap_or_default();
+                let (l, f) = if ov.method.is_some() {
+                    (None, "--method")
+                } else {
+                    (method_loc, "integrator.method")
+                };
                 return Err(err(
-                    method_loc,
-                    "integrator.method",
+                    l,
+                    f,
                     format!(
                         "unknown method `{other}`, expected one of {}{hint}",
                         Method::NAMES.join(", ")
@@ -746,21 +783,53 @@ impl ScenarioFile {
         if let Method::Rk4 { dt } = method
             && duration / dt > 1e11
         {
+            let (l, f) = if ov.dt.is_some() || ov.duration.is_some() {
+                (None, "--dt / --duration")
+            } else {
+                (spec.dt.as_ref().and_then(loc), "integrator.dt")
+            };
             return Err(err(
-                spec.dt.as_ref().and_then(loc),
-                "integrator.dt",
+                l,
+                f,
                 format!(
-                    "{:.1e} steps of {dt} s over {duration} s is too many",
+                    "{:.1e} steps of {dt:e} s over {duration:e} s is too many (limit 1e11)",
                     duration / dt
+                ),
+            ));
+        }
+        // Bound the work a valid-looking file can ask for.
+        let max_steps = match method {
+            Method::Dopri5 { max_step, .. } => duration / max_step,
+            Method::Exact => duration * output_rate_hint(&self.output).max(4.0 * omega0.norm()),
+            Method::Rk4 { .. } => 0.0,
+        };
+        if max_steps > 1e11 {
+            let (l, f) = match (&spec.max_step, ov.duration) {
+                (Some(m), _) => (loc(m), "integrator.max_step"),
+                (None, Some(_)) => (None, "--duration"),
+                (None, None) => (loc(&self.duration), "duration"),
+            };
+            return Err(err(
+                l,
+                f,
+                format!(
+                    "the run would need at least {max_steps:.1e} steps; the limit is 1e11 \
+                     (a larger max_step, or a shorter duration)"
                 ),
             ));
         }
         if let Method::Dopri5 { rtol, .. } = method
             && rtol < 1e-15
         {
-            return Err(err(
+            let (l, f) = from(
+                ov.rtol,
                 spec.rtol.as_ref().and_then(loc),
                 "integrator.rtol",
+                "--rtol",
+            );
+            return Err(err(
+                l,
+                f,
                 format!("rtol {rtol:e} is below double precision; use at least 1e-15"),
             ));
         }
@@ -782,11 +851,19 @@ impl ScenarioFile {
             }
         };
         if duration * output_rate > MAX_SAMPLES {
+            let (l, f) = if ov.duration.is_some() {
+                (None, "--duration")
+            } else {
+                (
+                    out.rate.as_ref().and_then(loc).or(loc(&self.duration)),
+                    "output.rate",
+                )
+            };
             return Err(err(
-                out.rate.as_ref().and_then(loc).or(loc(&self.duration)),
-                "output.rate",
+                l,
+                f,
                 format!(
-                    "{:.3e} samples ({duration} s at {output_rate} Hz) exceed the limit of \
+                    "{:.3e} samples ({duration:e} s at {output_rate:e} Hz) exceed the limit of \
                      {MAX_SAMPLES:e}; lower the rate or the duration",
                     duration * output_rate
                 ),
@@ -820,6 +897,19 @@ impl ScenarioFile {
             None => parse_epoch(DEFAULT_EPOCH).expect("the default epoch parses"),
             Some(e) => parse_epoch(&e.value).map_err(|m| err(loc(e), "epoch", m))?,
         };
+        // The log's time stamps (epoch + sim time) must fit Foxglove's 32-bit seconds.
+        let end_s = epoch_unix_ns as f64 * 1e-9 + duration;
+        if end_s >= LAST_LOG_SECOND as f64 {
+            return Err(err(
+                duration_loc,
+                duration_field,
+                format!(
+                    "epoch {} plus {duration:e} s ends after 2106-02-07T06:28:16Z, the last \
+                     time a log can stamp; shorten the run or choose an earlier epoch",
+                    format_epoch(epoch_unix_ns)
+                ),
+            ));
+        }
 
         let stop = conditions(path, "stop", &self.stop)?;
         let events = conditions(path, "events", &self.events)?;
@@ -852,6 +942,15 @@ impl ScenarioFile {
             shape,
         })
     }
+}
+
+/// The output rate as given (Hz), or the default, before validation (for work estimates).
+fn output_rate_hint(out: &Option<OutputSpec>) -> f64 {
+    out.as_ref()
+        .and_then(|o| o.rate.as_ref())
+        .map(|r| r.value)
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .unwrap_or(100.0)
 }
 
 fn sanitize(name: &str) -> String {

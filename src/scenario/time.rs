@@ -26,6 +26,10 @@ fn civil_from_days(z: i64) -> (i64, i64, i64) {
     (yoe + era * 400 + i64::from(m <= 2), m, d)
 }
 
+/// First Unix second that log timestamps cannot hold: Foxglove's `Timestamp` stores seconds
+/// as `u32` (2106-02-07T06:28:16Z).
+pub const LAST_LOG_SECOND: u64 = 1 << 32;
+
 /// Parses `YYYY-MM-DDTHH:MM:SS[.fraction]Z` (UTC) to Unix time in nanoseconds.
 ///
 /// MCAP log times are unsigned, so epochs before 1970 are refused with an explanation.
@@ -88,9 +92,11 @@ pub fn parse_epoch(text: &str) -> Result<u64, String> {
         format!("{frac:0<9}").parse().map_err(|_| bad())?
     };
     let secs = days_from_civil(y, mo, d) * 86400 + h * 3600 + mi * 60 + sec;
-    // Leave room for the run's duration on top of the epoch.
-    if secs > 9_000_000_000 {
-        return Err(format!("`{s}` is too far in the future for MCAP log times"));
+    if secs >= LAST_LOG_SECOND as i64 {
+        return Err(format!(
+            "`{s}` is too late: log timestamps hold seconds in 32 bits, so the epoch plus the \
+             run must stay before 2106-02-07T06:28:16Z"
+        ));
     }
     Ok(secs as u64 * 1_000_000_000 + nanos)
 }
@@ -133,7 +139,8 @@ mod tests {
 
     #[test]
     fn round_trip_over_many_days() {
-        for day in (0..60_000).step_by(37) {
+        // Every representable epoch: 1970 to just before 2106-02-07 (2^32 s).
+        for day in (0..49_710).step_by(37) {
             let ns = day as u64 * 86_400_000_000_000 + 12_345_678_901;
             assert_eq!(parse_epoch(&format_epoch(ns)), Ok(ns));
         }
@@ -148,6 +155,7 @@ mod tests {
             "2000-01-01T00:00:00",
             "1958-02-01T03:48:00Z",
             "2000-01-01T24:00:00Z",
+            "2106-02-07T06:28:16Z",
         ] {
             assert!(parse_epoch(s).is_err(), "{s}");
         }
