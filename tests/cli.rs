@@ -19,6 +19,29 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// Writes `text` to `dir/name` and returns the path.
+fn write_scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+/// The `--summary` JSON written at `path`.
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The `status` of a log's `polhode` metadata record.
+fn log_status(bytes: &[u8]) -> String {
+    let summary = mcap::Summary::read(bytes).unwrap().unwrap();
+    let index = summary
+        .metadata_indexes
+        .iter()
+        .find(|i| i.name == "polhode")
+        .expect("metadata");
+    mcap::read::metadata(bytes, index).unwrap().metadata["status"].clone()
+}
+
 const GOOD: &str = "name: good
 body:
   principal: [1.0, 2.0, 3.0]
@@ -213,8 +236,7 @@ fn not_utf8() {
 #[test]
 fn unwritable_output_path() {
     let dir = scratch("unwritable");
-    let file = dir.join("good.yaml");
-    std::fs::write(&file, GOOD).unwrap();
+    let file = write_scenario(&dir, "good.yaml", GOOD);
     // A path under a regular file can never be created, whoever runs the test.
     let blocker = dir.join("not-a-dir");
     std::fs::write(&blocker, "x").unwrap();
@@ -241,8 +263,7 @@ fn unwritable_output_path() {
 #[test]
 fn run_writes_log_and_summary() {
     let dir = scratch("run");
-    let file = dir.join("good.yaml");
-    std::fs::write(&file, GOOD).unwrap();
+    let file = write_scenario(&dir, "good.yaml", GOOD);
     let mcap = dir.join("good.mcap");
     let summary = dir.join("summary.json");
     let out = polhode()
@@ -257,8 +278,7 @@ fn run_writes_log_and_summary() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(mcap.exists());
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let json: serde_json::Value = read_json(&summary);
     for key in [
         "status",
         "body",
@@ -303,8 +323,7 @@ fn run_writes_log_and_summary() {
 #[test]
 fn overrides_from_the_command_line() {
     let dir = scratch("overrides");
-    let file = dir.join("good.yaml");
-    std::fs::write(&file, GOOD).unwrap();
+    let file = write_scenario(&dir, "good.yaml", GOOD);
     let summary = dir.join("s.json");
     let out = polhode()
         .args([
@@ -327,8 +346,7 @@ fn overrides_from_the_command_line() {
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(out.stdout.is_empty());
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let json: serde_json::Value = read_json(&summary);
     assert_eq!(json["method"], "rk4");
     assert_eq!(json["steps"].as_u64(), Some(300));
     assert_eq!(json["rhs_evaluations"].as_u64(), Some(1200));
@@ -345,8 +363,7 @@ fn stop_event_ends_the_run_at_the_crossing() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let json: serde_json::Value = read_json(&summary);
     assert_eq!(json["status"]["kind"], "stopped");
     let t = json["events"][0]["t"].as_f64().unwrap();
     assert_eq!(json["final"]["t"].as_f64(), Some(t));
@@ -452,14 +469,7 @@ fn assert_partial_log_is_valid(path: &Path) {
         n += 1;
     }
     assert!(n > 3, "only {n} messages");
-    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
-    let index = summary
-        .metadata_indexes
-        .iter()
-        .find(|i| i.name == "polhode")
-        .expect("metadata");
-    let meta = mcap::read::metadata(&bytes, index).unwrap();
-    assert_eq!(meta.metadata["status"], "interrupted (partial)");
+    assert_eq!(log_status(&bytes), "interrupted (partial)");
 }
 
 /// An explicit method far above its stability limit: the run stops with a diagnosis (time,
@@ -494,8 +504,7 @@ fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
     let err = stderr(&out);
     assert!(err.contains("non-finite in the step from t = "), "{err}");
     assert!(err.contains("stability limit"), "{err}");
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let json: serde_json::Value = read_json(&summary);
     assert_eq!(json["status"]["kind"], "failed");
     let w = json["final"]["omega"].as_array().unwrap();
     assert!(
@@ -507,13 +516,7 @@ fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
         m.unwrap();
     }
     let s = mcap::Summary::read(&bytes).unwrap().unwrap();
-    let index = s
-        .metadata_indexes
-        .iter()
-        .find(|i| i.name == "polhode")
-        .unwrap();
-    let meta = mcap::read::metadata(&bytes, index).unwrap();
-    assert_eq!(meta.metadata["status"], "failed (partial)");
+    assert_eq!(log_status(&bytes), "failed (partial)");
     // The last finite state is the log's last sample: /telemetry field 1 is sim_time, a
     // protobuf double (key 0x09, then 8 bytes little-endian).
     let telemetry = s
@@ -537,8 +540,7 @@ fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
 #[test]
 fn option_errors_name_the_option() {
     let dir = scratch("options");
-    let file = dir.join("good.yaml");
-    std::fs::write(&file, GOOD).unwrap();
+    let file = write_scenario(&dir, "good.yaml", GOOD);
     for (args, field) in [
         (vec!["--duration", "nan"], "--duration"),
         (vec!["--method", "dopri6"], "--method"),
@@ -584,8 +586,7 @@ fn unbounded_work_and_unstampable_times_are_refused() {
 #[test]
 fn summary_and_log_must_differ() {
     let dir = scratch("same");
-    let file = dir.join("good.yaml");
-    std::fs::write(&file, GOOD).unwrap();
+    let file = write_scenario(&dir, "good.yaml", GOOD);
     let target = dir.join("x.out");
     let out = polhode()
         .args([

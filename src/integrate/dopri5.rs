@@ -314,29 +314,7 @@ impl Stepper for Dopri5 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// y' = λ y, exact solution e^{λt}.
-    struct Exponential(f64);
-    impl OdeSystem for Exponential {
-        fn dim(&self) -> usize {
-            1
-        }
-        fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
-            dydt[0] = self.0 * y[0];
-        }
-    }
-
-    /// Harmonic oscillator y'' = −y: (cos t, −sin t).
-    struct Oscillator;
-    impl OdeSystem for Oscillator {
-        fn dim(&self) -> usize {
-            2
-        }
-        fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
-            dydt[0] = y[1];
-            dydt[1] = -y[0];
-        }
-    }
+    use crate::integrate::test_systems::{Clock, Exponential, Oscillator};
 
     #[test]
     fn meets_tolerance_on_exponential() {
@@ -378,15 +356,6 @@ mod tests {
     /// y' = 1 from a large t0 with many steps: integrated time equals the label at the end.
     #[test]
     fn integrated_time_matches_the_time_label() {
-        struct Clock;
-        impl OdeSystem for Clock {
-            fn dim(&self) -> usize {
-                1
-            }
-            fn rhs(&self, _t: f64, _y: &[f64], d: &mut [f64]) {
-                d[0] = 1.0;
-            }
-        }
         let (t0, t_end) = (1.0e6, 1.0e6 + 1.0e4);
         let tol = Tolerances {
             rtol: 1e-10,

@@ -8,6 +8,8 @@
 
 mod dopri5;
 mod rk4;
+#[cfg(test)]
+mod test_systems;
 
 pub use dopri5::Dopri5;
 pub use rk4::Rk4;

@@ -172,6 +172,7 @@ impl Stepper for Rk4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrate::test_systems::{Clock, Exponential};
 
     /// A 7-state system (the fixed-size path) and the same system with an 8th, inert state
     /// (the general path): the first seven components must agree bit for bit.
@@ -215,15 +216,6 @@ mod tests {
     /// steps, and the shortened last step then hides the drift in the state instead.
     #[test]
     fn integrated_time_matches_the_time_label() {
-        struct Clock;
-        impl OdeSystem for Clock {
-            fn dim(&self) -> usize {
-                1
-            }
-            fn rhs(&self, _t: f64, _y: &[f64], d: &mut [f64]) {
-                d[0] = 1.0;
-            }
-        }
         let (t0, t_end) = (1.0e6, 1.0e6 + 1.0e4);
         let mut s = Rk4::new(t0, &[0.0], 0.1);
         while s.t() < t_end {
@@ -236,19 +228,10 @@ mod tests {
     #[test]
     fn convergence_order_is_four() {
         // y' = −y on [0, 2]: error against e^{−2} at two steps.
-        struct Decay;
-        impl OdeSystem for Decay {
-            fn dim(&self) -> usize {
-                1
-            }
-            fn rhs(&self, _t: f64, y: &[f64], d: &mut [f64]) {
-                d[0] = -y[0];
-            }
-        }
         let err = |dt: f64| {
             let mut s = Rk4::new(0.0, &[1.0], dt);
             while s.t() < 2.0 {
-                s.step(&Decay, 2.0).unwrap();
+                s.step(&Exponential(-1.0), 2.0).unwrap();
             }
             (s.y()[0] - (-2.0f64).exp()).abs()
         };
