@@ -287,9 +287,10 @@ impl Stepper for ExactStepper {
         } else {
             self.t + self.h
         };
-        let mut y = vec![0.0; 7];
+        // Evaluate into a stack buffer (the hemisphere reference is the current state).
+        let mut y = [0.0; 7];
         self.evaluate(t1, &mut y, &self.y);
-        self.y = y;
+        self.y.copy_from_slice(&y);
         self.t_prev = self.t;
         self.t = t1;
         self.stats.steps += 1;
@@ -355,6 +356,8 @@ fn drive<M: Stepper>(
 
     let mut prev = o0.clone();
     let mut last_obs = o0.clone();
+    // Event-check points of the current step: (time, observation).
+    let mut grid: Vec<(f64, Observation)> = Vec::with_capacity(interior_checks + 2);
     // Set when the state went non-finite: the time of the last finite state (held in `buf`).
     let mut last_good: Option<f64> = None;
     let mut last_poll = Instant::now();
@@ -404,7 +407,9 @@ fn drive<M: Stepper>(
         // and re-crosses within one long step is not missed.
         let mut found: Vec<(f64, &Condition, bool)> = Vec::new();
         if let Some(o1) = &o1 {
-            let mut grid = vec![(t0, prev.clone())];
+            // Reused across steps: no allocation per step once it has grown.
+            grid.clear();
+            grid.push((t0, prev.clone()));
             for j in 1..=interior_checks {
                 let t = t0 + (t1 - t0) * j as f64 / (interior_checks + 1) as f64;
                 stepper.interpolate(t, &mut buf);
