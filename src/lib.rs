@@ -10,6 +10,7 @@
 //! [`log`] (MCAP output), [`linearize`], and the command-line front end in [`cli`].
 
 pub mod cli;
+pub mod effectors;
 pub mod exact;
 pub mod integrate;
 pub mod linearize;

@@ -2,15 +2,20 @@
 //!
 //! The hub carries 7 states, body rates ω (rad/s) and the attitude quaternion `(w, x, y, z)`
 //! (body → inertial). Each [`Effector`] appends its own states and couples to the hub through
-//! [`HubCoupling`]: it may add torque and (for internal degrees of freedom, by back-substitution
-//! of its own accelerations) effective inertia to the hub's rotational equation
+//! [`HubCoupling`], the hub's equations of motion in the unknowns `z = [a_B; ω̇]` (the inertial
+//! acceleration of the hub's centre of mass B and the angular acceleration, both in body axes):
 //!
 //! ```text
-//! (I + Σ ΔI_e) ω̇ = −ω × (I ω) + Σ τ_e,
+//! [ m_hub·1   0     ] [a_B]   [ 0                 ]
+//! [ 0         I_hub ] [ ω̇ ] + Σ_e (what e adds)  =  [ −ω × (I_hub ω) + τ_ext ]
 //! ```
 //!
-//! after which each effector computes its own state derivatives from ω̇. A scene without
-//! effectors integrates exactly 7 numbers and takes a path with no matrix solve.
+//! An effector with internal degrees of freedom solves its own equations for its accelerations
+//! as an affine function of `z` and substitutes them into the hub's (back-substitution, as in
+//! Basilisk's hub-and-effector design), so effectors couple to one another only through the hub
+//! and the translation of the hub (the shift of the system centre of mass) is exact for any
+//! number of moving masses. When no effector moves mass, only the rotational 3×3 block is
+//! solved, and a scene without effectors integrates exactly 7 numbers with no matrix solve.
 
 mod body;
 mod observe;
@@ -19,21 +24,57 @@ pub use body::{InertiaError, RigidBody};
 pub use observe::{Invariants, Observation};
 
 use crate::integrate::OdeSystem;
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+use std::cell::RefCell;
 use std::fmt::Debug;
 
 /// Number of hub states: ω (3) and q (4).
 pub const HUB_STATES: usize = 7;
 
-/// What effectors add to the hub's rotational equation `inertia · ω̇ = torque` (body frame,
-/// about the system centre of mass).
+/// The hub's equations of motion `mass · [a_B; ω̇] = force` as effectors see them (body axes,
+/// moments about the hub's centre of mass B).
 #[derive(Debug, Clone, PartialEq)]
 pub struct HubCoupling {
-    /// Effective inertia (kg m²): starts as the hub's tensor; internal degrees of freedom add
-    /// their back-substituted coupling.
-    pub inertia: Matrix3<f64>,
-    /// Torque (N m): starts as the gyroscopic term −ω × (Iω); effectors add theirs.
-    pub torque: Vector3<f64>,
+    /// Generalised mass (kg, kg m, kg m²): translation rows/columns first, then rotation.
+    pub mass: Matrix6<f64>,
+    /// Generalised force (N; N m): starts as `[0; −ω × (I ω)]`.
+    pub force: Vector6<f64>,
+    /// Set by effectors that move mass relative to the hub: the translational block must be
+    /// solved too. Otherwise `a_B = 0` and only the rotational block is solved.
+    pub translation: bool,
+}
+
+impl HubCoupling {
+    /// Adds a torque (N m, body axes) to the rotational equation.
+    #[inline]
+    pub fn add_torque(&mut self, torque: &Vector3<f64>) {
+        self.force[3] += torque[0];
+        self.force[4] += torque[1];
+        self.force[5] += torque[2];
+    }
+}
+
+/// The hub's accelerations, solved from [`HubCoupling`] (or prescribed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HubAcceleration {
+    /// Inertial acceleration of the hub's centre of mass, body axes (m/s²).
+    pub linear: Vector3<f64>,
+    /// Angular acceleration ω̇, body axes (rad/s²).
+    pub angular: Vector3<f64>,
+}
+
+impl HubAcceleration {
+    /// `[a_B; ω̇]` as one 6-vector.
+    pub fn as_vector6(&self) -> Vector6<f64> {
+        Vector6::new(
+            self.linear[0],
+            self.linear[1],
+            self.linear[2],
+            self.angular[0],
+            self.angular[1],
+            self.angular[2],
+        )
+    }
 }
 
 /// Read-only view of the hub state an effector sees.
@@ -47,30 +88,153 @@ pub struct HubState<'a> {
     pub attitude: &'a [f64],
 }
 
+/// Mass and momentum an effector carries beyond the rigid hub, in the frame that translates
+/// with the hub's centre of mass B and rotates with the body (body axes, about B).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Momentum {
+    /// Moving mass (kg): mass not counted in the hub's.
+    pub mass: f64,
+    /// First moment Σ m r of that mass about B (kg m).
+    pub first_moment: Vector3<f64>,
+    /// Linear momentum Σ m (ω × r + ṙ) relative to B's velocity (kg m/s).
+    pub linear: Vector3<f64>,
+    /// Angular momentum about B relative to B's velocity (N m s), including any spinning
+    /// rotor's relative momentum.
+    pub angular: Vector3<f64>,
+    /// Kinetic energy relative to B's velocity (J), beyond the hub's ½ ωᵀ I ω.
+    pub kinetic_energy: f64,
+}
+
+/// Energy an effector stores and has dissipated.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct EnergyAccount {
+    /// Elastic (spring) potential energy (J).
+    pub elastic: f64,
+    /// Energy dissipated since t = 0 (J): an integrated bookkeeping state.
+    pub dissipated: f64,
+    /// Present dissipation rate (W, ≥ 0).
+    pub power: f64,
+}
+
+/// Something an effector asks the 3D view to draw, in body axes about B (m).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Drawing {
+    /// A polyline through points.
+    Line {
+        /// Vertices (m, body axes).
+        points: Vec<Vector3<f64>>,
+        /// Line width (m).
+        thickness: f64,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre (m, body axes).
+        center: Vector3<f64>,
+        /// Diameter (m).
+        diameter: f64,
+    },
+    /// A short cylinder (disc) about an axis.
+    Disc {
+        /// Centre (m, body axes).
+        center: Vector3<f64>,
+        /// Unit axis (body axes).
+        axis: Vector3<f64>,
+        /// Diameter (m).
+        diameter: f64,
+        /// Thickness along the axis (m).
+        thickness: f64,
+    },
+}
+
 /// A part of the spacecraft with its own states and couplings (dampers, appendages, torques).
 ///
-/// Implementations must keep `num_states()` fixed for their lifetime.
+/// State layout: `num_dynamic_states()` dynamic states first, then bookkeeping states (such as
+/// the dissipated energy) that nothing else depends on. Implementations must keep the counts
+/// fixed for their lifetime. An effector at rest has all-zero states.
 pub trait Effector: Debug + Send + Sync {
     /// Unique name within the spacecraft (used for telemetry topics).
     fn name(&self) -> &str;
+    /// The kind as written in YAML (`rayleigh`, `hinged_rod`, …).
+    fn kind(&self) -> &'static str;
     /// Number of states this effector appends to the state vector.
     fn num_states(&self) -> usize;
+    /// How many of its states (the leading ones) are dynamic; the rest are bookkeeping.
+    fn num_dynamic_states(&self) -> usize {
+        self.num_states()
+    }
     /// Names of its states, for logs (length `num_states()`).
     fn state_names(&self) -> Vec<String>;
     /// Initial values of its states.
     fn initial_state(&self) -> Vec<f64>;
-    /// Adds torque and effective inertia to the hub equation, given its own states `x`.
-    fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling);
-    /// Writes the derivatives of its own states given the hub acceleration `omega_dot`.
-    fn derivatives(&self, hub: &HubState, omega_dot: &Vector3<f64>, x: &[f64], dx: &mut [f64]);
-    /// Angular momentum it carries beyond the rigid hub's (N m s, body frame).
-    fn angular_momentum(&self, _hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        Vector3::zeros()
+    /// Whether it moves mass relative to the hub (needs the hub's translation and mass).
+    fn moves_mass(&self) -> bool {
+        false
     }
-    /// Kinetic energy it carries beyond the rigid hub's (J).
-    fn kinetic_energy(&self, _hub: &HubState, _x: &[f64]) -> f64 {
-        0.0
+    /// Whether it applies an external torque (then H is not conserved).
+    fn is_external(&self) -> bool {
+        false
     }
+    /// Length of the scratch space `couple` may fill for `derivatives` (numbers).
+    fn scratch_len(&self) -> usize {
+        0
+    }
+    /// Adds its terms to the hub equations, given its own states `x`; may leave intermediate
+    /// results in `scratch` for [`Effector::derivatives`].
+    fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]);
+    /// Writes the derivatives of its own states given the hub accelerations.
+    fn derivatives(
+        &self,
+        hub: &HubState,
+        accel: &HubAcceleration,
+        x: &[f64],
+        scratch: &[f64],
+        dx: &mut [f64],
+    );
+    /// Mass and momentum it carries beyond the rigid hub.
+    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
+        Momentum::default()
+    }
+    /// Stored and dissipated energy.
+    fn energy(&self, _hub: &HubState, _x: &[f64]) -> EnergyAccount {
+        EnergyAccount::default()
+    }
+    /// Names of its telemetry fields (units in `docs/effectors.md`).
+    fn telemetry_names(&self) -> Vec<String> {
+        self.state_names()
+    }
+    /// Telemetry values at a sample, in the order of [`Effector::telemetry_names`].
+    fn telemetry(&self, _hub: &HubState, x: &[f64]) -> Vec<f64> {
+        x.to_vec()
+    }
+    /// What the 3D view draws for it at states `x`.
+    fn drawings(&self, _x: &[f64]) -> Vec<Drawing> {
+        Vec::new()
+    }
+}
+
+/// A prescribed hub rotation (a motor drives the hub; its centre of mass is pinned).
+pub trait HubMotion: Debug + Send + Sync {
+    /// Body rates ω(t) (rad/s).
+    fn omega(&self, t: f64) -> Vector3<f64>;
+    /// Angular acceleration ω̇(t) (rad/s²).
+    fn omega_dot(&self, t: f64) -> Vector3<f64>;
+    /// One-line description for logs.
+    fn describe(&self) -> String;
+}
+
+/// Why an effector could not be added.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AddEffectorError(pub String);
+
+impl std::fmt::Display for AddEffectorError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+thread_local! {
+    /// Per-thread scratch space for effectors (no allocation per right-hand-side call).
+    static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
 }
 
 /// The hub plus its effectors: an [`OdeSystem`] over `[ω, q, effector states…]`.
@@ -78,14 +242,22 @@ pub trait Effector: Debug + Send + Sync {
 pub struct Spacecraft {
     /// The rigid hub.
     pub hub: RigidBody,
+    /// Hub mass (kg), required when an effector moves mass.
+    pub hub_mass: Option<f64>,
     /// Unit vector in body axes whose angle to H is the reported nutation angle.
     pub spin_axis: Vector3<f64>,
     effectors: Vec<Box<dyn Effector>>,
+    /// When set, the hub's rotation is prescribed and its centre of mass pinned.
+    motion: Option<Box<dyn HubMotion>>,
     /// When the body axes are principal: `[(I2−I3)/I1, (I3−I1)/I2, (I1−I2)/I3]`, the
     /// coefficients of Euler's equations in their 3-term form (exact, fewer operations).
     euler_coefficients: Option<[f64; 3]>,
     /// Offset of each effector's states in the state vector.
     offsets: Vec<usize>,
+    /// Offset of each effector's scratch space.
+    scratch_offsets: Vec<usize>,
+    scratch_len: usize,
+    translation: bool,
     dim: usize,
 }
 
@@ -101,23 +273,69 @@ impl Spacecraft {
         Spacecraft {
             euler_coefficients,
             hub,
+            hub_mass: None,
             spin_axis: spin_axis.normalize(),
             effectors: Vec::new(),
+            motion: None,
             offsets: Vec::new(),
+            scratch_offsets: Vec::new(),
+            scratch_len: 0,
+            translation: false,
             dim: HUB_STATES,
         }
     }
 
-    /// Appends an effector; its states follow those already present.
-    pub fn add_effector(&mut self, effector: Box<dyn Effector>) {
+    /// Appends an effector; its states follow those already present. Effectors that move mass
+    /// need the hub mass set first.
+    pub fn add_effector(&mut self, effector: Box<dyn Effector>) -> Result<(), AddEffectorError> {
+        if self.effectors.iter().any(|e| e.name() == effector.name()) {
+            return Err(AddEffectorError(format!(
+                "two effectors are named `{}`; names must be unique",
+                effector.name()
+            )));
+        }
+        if effector.moves_mass() {
+            if !self.hub_mass.is_some_and(|m| m.is_finite() && m > 0.0) {
+                return Err(AddEffectorError(format!(
+                    "effector `{}` moves mass relative to the hub, so the hub's mass is needed: \
+                     expected `body.mass` (kg)",
+                    effector.name()
+                )));
+            }
+            self.translation = true;
+        }
         self.offsets.push(self.dim);
         self.dim += effector.num_states();
+        self.scratch_offsets.push(self.scratch_len);
+        self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
+        Ok(())
+    }
+
+    /// Prescribes the hub's rotation (its centre of mass is then pinned in inertial space).
+    pub fn set_motion(&mut self, motion: Box<dyn HubMotion>) {
+        self.motion = Some(motion);
+    }
+
+    /// The prescribed hub motion, if any.
+    pub fn motion(&self) -> Option<&dyn HubMotion> {
+        self.motion.as_deref()
     }
 
     /// The effectors, in state order.
     pub fn effectors(&self) -> &[Box<dyn Effector>] {
         &self.effectors
+    }
+
+    /// Whether the total angular momentum is conserved (no external torque, no prescribed
+    /// motion): then its drift is a measure of integration error.
+    pub fn conserves_momentum(&self) -> bool {
+        self.motion.is_none() && !self.effectors.iter().any(|e| e.is_external())
+    }
+
+    /// Whether kinetic + elastic + dissipated energy is conserved (no prescribed motion).
+    pub fn conserves_energy(&self) -> bool {
+        self.motion.is_none()
     }
 
     /// The initial state vector for body rates `omega` (rad/s) and attitude `q`.
@@ -129,6 +347,19 @@ impl Spacecraft {
             y.extend(e.initial_state());
         }
         y
+    }
+
+    /// The state with every effector at rest (all effector states zero).
+    pub fn rest_state(&self, omega: &Vector3<f64>, q: &UnitQuaternion<f64>) -> Vec<f64> {
+        let mut y = vec![0.0; self.dim];
+        y[..3].copy_from_slice(omega.as_slice());
+        y[3..7].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        y
+    }
+
+    /// Offset of effector `index`'s states in the state vector.
+    pub fn effector_offset(&self, index: usize) -> usize {
+        self.offsets[index]
     }
 
     /// The slice of `y` holding effector `index`'s states.
@@ -147,6 +378,25 @@ impl Spacecraft {
         observe::invariants(self, t, y).0
     }
 
+    /// Inertia tensor of the whole spacecraft about its centre of mass with the effectors in
+    /// the configuration of `y`, as if locked (kg m², body axes).
+    pub fn system_inertia(&self, y: &[f64]) -> Matrix3<f64> {
+        // H is linear in ω and the effector rates jointly, so the difference H(ω = e_c) − H(0)
+        // is the inertia's column c whatever the effectors' rates are.
+        let mut frozen = y.to_vec();
+        let h_of = |w: Vector3<f64>, state: &mut Vec<f64>| {
+            state[..3].copy_from_slice(w.as_slice());
+            self.invariants(0.0, state).h_body
+        };
+        let h0 = h_of(Vector3::zeros(), &mut frozen);
+        let mut inertia = Matrix3::zeros();
+        for c in 0..3 {
+            let h = h_of(Vector3::ith(c, 1.0), &mut frozen);
+            inertia.set_column(c, &(h - h0));
+        }
+        inertia
+    }
+
     /// Hub acceleration ω̇ (rad/s²) for the hub-only case: `I⁻¹ (−ω × Iω)`.
     #[inline(always)]
     fn rigid_omega_dot(&self, omega: &Vector3<f64>) -> Vector3<f64> {
@@ -159,6 +409,137 @@ impl Spacecraft {
         }
         let h = self.hub.inertia * omega;
         self.hub.inertia_inv * (-omega.cross(&h))
+    }
+
+    /// The hub's equations with every effector's terms added, at state `y`; effectors leave
+    /// their intermediate results in `scratch`.
+    fn coupling(&self, hub: &HubState, y: &[f64], scratch: &mut [f64]) -> HubCoupling {
+        let omega = hub.omega;
+        let mut mass = Matrix6::zeros();
+        let m = self.hub_mass.unwrap_or(1.0);
+        for i in 0..3 {
+            mass[(i, i)] = m;
+        }
+        mass.fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&self.hub.inertia);
+        let gyro = -omega.cross(&(self.hub.inertia * omega));
+        let mut coupling = HubCoupling {
+            mass,
+            force: Vector6::new(0.0, 0.0, 0.0, gyro[0], gyro[1], gyro[2]),
+            translation: self.translation,
+        };
+        for (k, e) in self.effectors.iter().enumerate() {
+            let off = self.offsets[k];
+            let s = self.scratch_offsets[k];
+            e.couple(
+                hub,
+                &y[off..off + e.num_states()],
+                &mut coupling,
+                &mut scratch[s..s + e.scratch_len()],
+            );
+        }
+        coupling
+    }
+
+    /// Right-hand side with the hub's accelerations taken from `solve(coupling)`.
+    #[inline(always)]
+    fn effector_rhs(
+        &self,
+        t: f64,
+        y: &[f64],
+        dydt: &mut [f64],
+        solve: impl FnOnce(&HubCoupling) -> HubAcceleration,
+    ) -> Vector3<f64> {
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let hub = HubState {
+            t,
+            omega,
+            attitude: &y[3..7],
+        };
+        SCRATCH.with(|cell| {
+            let mut scratch = cell.borrow_mut();
+            if scratch.len() < self.scratch_len {
+                scratch.resize(self.scratch_len, 0.0);
+            }
+            let coupling = self.coupling(&hub, y, &mut scratch);
+            let accel = solve(&coupling);
+            for (k, e) in self.effectors.iter().enumerate() {
+                let off = self.offsets[k];
+                let n = e.num_states();
+                let s = self.scratch_offsets[k];
+                e.derivatives(
+                    &hub,
+                    &accel,
+                    &y[off..off + n],
+                    &scratch[s..s + e.scratch_len()],
+                    &mut dydt[off..off + n],
+                );
+            }
+            accel.angular
+        })
+    }
+
+    /// Right-hand side with the hub's rotation prescribed as ω̇ = `omega_dot` (the state's ω
+    /// is used as it is). With `free_translation` the hub's centre of mass moves so that the
+    /// total linear momentum is conserved; otherwise it is pinned (a_B = 0). Used for
+    /// prescribed-motion scenes and the energy-sink estimate of `linearize`.
+    pub fn rhs_prescribed(
+        &self,
+        t: f64,
+        y: &[f64],
+        omega_dot: &Vector3<f64>,
+        free_translation: bool,
+        dydt: &mut [f64],
+    ) {
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let wd = *omega_dot;
+        let translation = self.translation;
+        self.effector_rhs(t, y, dydt, |c| {
+            let linear = if free_translation && translation {
+                // Translational rows: M_tt a_B + M_tr ω̇ = f_t.
+                let m_tt = c.mass.fixed_view::<3, 3>(0, 0).into_owned();
+                let m_tr = c.mass.fixed_view::<3, 3>(0, 3).into_owned();
+                let f_t = Vector3::new(c.force[0], c.force[1], c.force[2]);
+                m_tt.lu()
+                    .solve(&(f_t - m_tr * wd))
+                    .unwrap_or_else(|| Vector3::repeat(f64::NAN))
+            } else {
+                Vector3::zeros()
+            };
+            HubAcceleration {
+                linear,
+                angular: wd,
+            }
+        });
+        dydt[..3].copy_from_slice(omega_dot.as_slice());
+        quaternion_rate(&y[3..7], &omega, &mut dydt[3..7]);
+    }
+}
+
+/// Solves the hub's equations for its accelerations.
+#[inline(always)]
+fn solve_hub(c: &HubCoupling) -> HubAcceleration {
+    if c.translation {
+        match c.mass.lu().solve(&c.force) {
+            Some(z) => HubAcceleration {
+                linear: Vector3::new(z[0], z[1], z[2]),
+                angular: Vector3::new(z[3], z[4], z[5]),
+            },
+            None => HubAcceleration {
+                linear: Vector3::repeat(f64::NAN),
+                angular: Vector3::repeat(f64::NAN),
+            },
+        }
+    } else {
+        let m_rr = c.mass.fixed_view::<3, 3>(3, 3).into_owned();
+        let f_r = Vector3::new(c.force[3], c.force[4], c.force[5]);
+        HubAcceleration {
+            linear: Vector3::zeros(),
+            angular: m_rr
+                .lu()
+                .solve(&f_r)
+                .unwrap_or_else(|| Vector3::repeat(f64::NAN)),
+        }
     }
 }
 
@@ -180,39 +561,22 @@ impl OdeSystem for Spacecraft {
 
     #[inline(always)]
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
-        let hub_y = &y[..HUB_STATES];
-        let omega = Vector3::new(hub_y[0], hub_y[1], hub_y[2]);
+        if let Some(motion) = &self.motion {
+            let wd = motion.omega_dot(t);
+            self.rhs_prescribed(t, y, &wd, false, dydt);
+            return;
+        }
+        let omega = Vector3::new(y[0], y[1], y[2]);
         let omega_dot = if self.effectors.is_empty() {
             self.rigid_omega_dot(&omega)
         } else {
-            let hub = HubState {
-                t,
-                omega,
-                attitude: &y[3..7],
-            };
-            let mut coupling = HubCoupling {
-                inertia: self.hub.inertia,
-                torque: -omega.cross(&(self.hub.inertia * omega)),
-            };
-            for (e, &off) in self.effectors.iter().zip(&self.offsets) {
-                e.couple(&hub, &y[off..off + e.num_states()], &mut coupling);
-            }
-            let omega_dot = coupling
-                .inertia
-                .lu()
-                .solve(&coupling.torque)
-                .unwrap_or_else(|| Vector3::repeat(f64::NAN));
-            for (e, &off) in self.effectors.iter().zip(&self.offsets) {
-                let n = e.num_states();
-                e.derivatives(&hub, &omega_dot, &y[off..off + n], &mut dydt[off..off + n]);
-            }
-            omega_dot
+            self.effector_rhs(t, y, dydt, solve_hub)
         };
         let hub_dy = &mut dydt[..HUB_STATES];
         hub_dy[0] = omega_dot[0];
         hub_dy[1] = omega_dot[1];
         hub_dy[2] = omega_dot[2];
-        quaternion_rate(&hub_y[3..7], &omega, &mut hub_dy[3..7]);
+        quaternion_rate(&y[3..7], &omega, &mut hub_dy[3..7]);
     }
 }
 
@@ -237,10 +601,23 @@ mod tests {
         fn initial_state(&self) -> Vec<f64> {
             vec![0.0]
         }
-        fn couple(&self, _hub: &HubState, _x: &[f64], c: &mut HubCoupling) {
-            c.torque += self.0;
+        fn kind(&self) -> &'static str {
+            "constant_torque"
         }
-        fn derivatives(&self, hub: &HubState, _wd: &Vector3<f64>, _x: &[f64], dx: &mut [f64]) {
+        fn is_external(&self) -> bool {
+            true
+        }
+        fn couple(&self, _hub: &HubState, _x: &[f64], c: &mut HubCoupling, _s: &mut [f64]) {
+            c.add_torque(&self.0);
+        }
+        fn derivatives(
+            &self,
+            hub: &HubState,
+            _a: &HubAcceleration,
+            _x: &[f64],
+            _s: &[f64],
+            dx: &mut [f64],
+        ) {
             dx[0] = self.0.dot(&hub.omega);
         }
     }
@@ -262,7 +639,7 @@ mod tests {
         let hub = RigidBody::from_principal([1.0, 2.0, 3.0]).unwrap();
         let mut sc = Spacecraft::new(hub, Vector3::z());
         let tau = Vector3::new(0.01, -0.02, 0.005);
-        sc.add_effector(Box::new(ConstantTorque(tau)));
+        sc.add_effector(Box::new(ConstantTorque(tau))).unwrap();
         assert_eq!(sc.dim(), 8);
         let y0 = sc.initial_state(&Vector3::new(0.3, 0.5, 0.8), &UnitQuaternion::identity());
         let t0 = sc.observe(0.0, &y0).kinetic_energy;

@@ -20,12 +20,25 @@ pub struct Observation {
     pub h_inertial: Vector3<f64>,
     /// `|H|` (N m s).
     pub h_norm: f64,
-    /// Rotational kinetic energy (J).
+    /// Kinetic energy of the whole spacecraft in its centre-of-mass frame (J).
     pub kinetic_energy: f64,
+    /// Elastic energy stored in the effectors' springs (J).
+    pub elastic_energy: f64,
+    /// Energy dissipated by the effectors since t = 0 (J).
+    pub dissipated_energy: f64,
+    /// Present total dissipation rate (W).
+    pub dissipation_power: f64,
     /// Angle between the scenario's spin axis and H (rad).
     pub nutation_angle: f64,
-    /// Angle between ω and each principal axis, in principal order (rad, in [0, π]).
+    /// Angle between ω and each principal axis of the hub, in principal order (rad, [0, π]).
     pub angles_to_principal: [f64; 3],
+}
+
+impl Observation {
+    /// Kinetic + elastic + dissipated energy (J): constant for a free spacecraft.
+    pub fn energy_balance(&self) -> f64 {
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy
+    }
 }
 
 /// Angle between two vectors (rad), accurate for small and near-π angles alike.
@@ -42,8 +55,21 @@ pub struct Invariants {
     pub h_inertial: Vector3<f64>,
     /// Kinetic energy (J).
     pub kinetic_energy: f64,
+    /// Elastic energy (J).
+    pub elastic_energy: f64,
+    /// Dissipated energy (J).
+    pub dissipated_energy: f64,
+    /// Present dissipation rate (W).
+    pub dissipation_power: f64,
     /// `|q| − 1`.
     pub q_norm_error: f64,
+}
+
+impl Invariants {
+    /// Kinetic + elastic + dissipated energy (J).
+    pub fn energy_balance(&self) -> f64 {
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy
+    }
 }
 
 pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, UnitQuaternion<f64>) {
@@ -53,16 +79,35 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
     let attitude = UnitQuaternion::new_unchecked(q_raw / q_norm);
     let mut h_body = sc.hub.inertia * omega;
     let mut kinetic_energy = 0.5 * omega.dot(&(sc.hub.inertia * omega));
+    let (mut elastic_energy, mut dissipated_energy, mut dissipation_power) = (0.0, 0.0, 0.0);
     if !sc.effectors().is_empty() {
         let hub = HubState {
             t,
             omega,
             attitude: &y[3..7],
         };
+        let mut total_mass = sc.hub_mass.unwrap_or(0.0);
+        let mut first_moment = Vector3::zeros();
+        let mut linear = Vector3::zeros();
         for (i, e) in sc.effectors().iter().enumerate() {
             let x = sc.effector_states(i, y);
-            h_body += e.angular_momentum(&hub, x);
-            kinetic_energy += e.kinetic_energy(&hub, x);
+            let m = e.momentum(&hub, x);
+            h_body += m.angular;
+            kinetic_energy += m.kinetic_energy;
+            total_mass += m.mass;
+            first_moment += m.first_moment;
+            linear += m.linear;
+            let a = e.energy(&hub, x);
+            elastic_energy += a.elastic;
+            dissipated_energy += a.dissipated;
+            dissipation_power += a.power;
+        }
+        // The system's linear momentum is zero, so the hub moves at v_B = −P_rel / M; that
+        // adds S × v_B to H and −½ |P_rel|² / M to T (values about the system centre of mass).
+        if total_mass > 0.0 && linear != Vector3::zeros() {
+            let v_hub = -linear / total_mass;
+            h_body += first_moment.cross(&v_hub);
+            kinetic_energy -= 0.5 * linear.norm_squared() / total_mass;
         }
     }
     let h_inertial = attitude * h_body;
@@ -70,6 +115,9 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
         h_body,
         h_inertial,
         kinetic_energy,
+        elastic_energy,
+        dissipated_energy,
+        dissipation_power,
         q_norm_error: q_norm - 1.0,
     };
     (inv, attitude)
@@ -78,24 +126,21 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
 pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64]) -> Observation {
     let (inv, attitude) = invariants(sc, t, y);
     let omega = Vector3::new(y[0], y[1], y[2]);
-    let Invariants {
-        h_body,
-        h_inertial,
-        kinetic_energy,
-        q_norm_error,
-    } = inv;
     let axes = &sc.hub.principal_axes;
     let angles_to_principal = [0, 1, 2].map(|c| angle_between(&omega, &axes.column(c).into()));
     Observation {
         t,
         omega,
         attitude,
-        q_norm_error,
-        h_body,
-        h_inertial,
-        h_norm: h_body.norm(),
-        kinetic_energy,
-        nutation_angle: angle_between(&sc.spin_axis, &h_body),
+        q_norm_error: inv.q_norm_error,
+        h_body: inv.h_body,
+        h_inertial: inv.h_inertial,
+        h_norm: inv.h_body.norm(),
+        kinetic_energy: inv.kinetic_energy,
+        elastic_energy: inv.elastic_energy,
+        dissipated_energy: inv.dissipated_energy,
+        dissipation_power: inv.dissipation_power,
+        nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
         angles_to_principal,
     }
 }

@@ -1,0 +1,33 @@
+//! Effectors: the parts a spacecraft is composed of beyond its rigid hub (docs/effectors.md).
+//!
+//! - [`Rayleigh`]: Rayleigh dissipation torque −Γω (external; drains |H| and T).
+//! - [`EnergySink`]: the quasi-rigid internal-dissipation torque that keeps |H|.
+//! - [`SpringMass`]: a particle on a line with spring and dashpot.
+//! - [`WheelDamper`]: a viscous wheel damper about a body axis.
+//! - [`HingedRod`]: a rigid rod on a hinge with one or two rotational degrees of freedom.
+//! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
+//!
+//! The three mass-moving ones share the particle formulation of [`particles`]; each effector
+//! adds only its own states.
+
+pub mod beam;
+pub mod energy_sink;
+pub mod hinged_rod;
+pub mod modal;
+pub mod motion;
+pub mod particles;
+pub mod rayleigh;
+pub mod spring_mass;
+pub mod wheel;
+
+pub use energy_sink::EnergySink;
+pub use hinged_rod::{HingeFreedom, HingedRod};
+pub use modal::ModalBeam;
+pub use motion::SpinUp;
+pub use particles::{ParticleEffector, ParticleModel};
+pub use rayleigh::Rayleigh;
+pub use spring_mass::SpringMass;
+pub use wheel::WheelDamper;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,406 @@
+//! Effectors made of particles whose body-frame positions are functions of a few coordinates
+//! (spring–mass dampers, hinged rods, modal beams), with their equations of motion derived
+//! once here, by the principle of virtual work, for all of them.
+//!
+//! Particle p has mass m_p and position r_p(q) about the hub's centre of mass B (body axes),
+//! with Jacobian J_p = ∂r_p/∂q (3 × n) and convective term κ_p = Σ_jk ∂²r_p/∂q_j∂q_k u_j u_k
+//! (u = q̇). Its inertial acceleration is
+//!
+//! ```text
+//! a_p = a_B + ω̇ × r_p + J_p u̇ + c_p,   c_p = ω × (ω × r_p) + 2 ω × (J_p u) + κ_p,
+//! ```
+//!
+//! and the coordinates obey Σ_p m_p J_pᵀ a_p = Q(q, u) (springs and dashpots). Writing
+//! z = [a_B; ω̇], that is `M u̇ = g − Cᵀ z` with
+//!
+//! ```text
+//! M = Σ m JᵀJ,  Cᵀ = Σ m [Jᵀ, Jᵀ[r×]ᵀ] (n × 6),  g = Q − Σ m Jᵀ c.
+//! ```
+//!
+//! The particles add `D z + C u̇ + e` to the hub's force and moment equations, with
+//! D = Σ m [[1, −[r×]], [[r×], |r|²1 − r rᵀ]] and e = Σ m [c; r × c]; substituting u̇ gives
+//! the back-substituted terms `mass += D − C M⁻¹ Cᵀ`, `force −= e + C M⁻¹ g`. Because every
+//! term comes from the same particle kinematics, the total momentum and energy are conserved
+//! exactly by the continuous equations (tested), whatever the kinematics.
+
+use crate::model::{
+    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
+};
+use nalgebra::{Matrix3, Vector3};
+use std::fmt::Debug;
+
+/// Largest number of coordinates a particle effector may have.
+pub const MAX_COORDINATES: usize = 24;
+
+/// One particle's kinematics at given coordinates and rates.
+#[derive(Debug, Clone)]
+pub struct ParticlePoint {
+    /// Mass (kg).
+    pub mass: f64,
+    /// Position about the hub's centre of mass B (m, body axes).
+    pub position: Vector3<f64>,
+    /// Columns of the Jacobian ∂r/∂q (m per unit coordinate); only the first n are used.
+    pub jacobian: [Vector3<f64>; MAX_COORDINATES],
+    /// Convective acceleration Σ ∂²r/∂q_j∂q_k u_j u_k (m/s²).
+    pub convective: Vector3<f64>,
+}
+
+impl Default for ParticlePoint {
+    fn default() -> Self {
+        ParticlePoint {
+            mass: 0.0,
+            position: Vector3::zeros(),
+            jacobian: [Vector3::zeros(); MAX_COORDINATES],
+            convective: Vector3::zeros(),
+        }
+    }
+}
+
+/// A set of particles moved by `n` coordinates, with springs and dashpots on them.
+pub trait ParticleModel: Debug + Send + Sync {
+    /// The YAML kind.
+    fn kind(&self) -> &'static str;
+    /// Number of coordinates n (≤ [`MAX_COORDINATES`]).
+    fn num_coordinates(&self) -> usize;
+    /// Names of the coordinates (their units in `docs/effectors.md`).
+    fn coordinate_names(&self) -> Vec<String>;
+    /// Number of particles.
+    fn num_particles(&self) -> usize;
+    /// Fills `out` with particle `p`'s kinematics at coordinates `q` and rates `u`.
+    fn particle(&self, p: usize, q: &[f64], u: &[f64], out: &mut ParticlePoint);
+    /// Generalised forces of springs and dashpots, written into `out` (length n).
+    fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]);
+    /// Elastic energy (J).
+    fn elastic_energy(&self, q: &[f64]) -> f64;
+    /// Dissipation rate (W).
+    fn dissipation_power(&self, q: &[f64], u: &[f64]) -> f64;
+    /// Extra telemetry (names), e.g. a tip deflection.
+    fn extra_telemetry_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Extra telemetry values at `q`.
+    fn extra_telemetry(&self, _q: &[f64]) -> Vec<f64> {
+        Vec::new()
+    }
+    /// What the 3D view draws at `q`.
+    fn drawings(&self, q: &[f64]) -> Vec<Drawing>;
+}
+
+/// A [`ParticleModel`] as an effector: states `[q (n), u (n), dissipated energy]`.
+#[derive(Debug)]
+pub struct ParticleEffector<P: ParticleModel> {
+    name: String,
+    model: P,
+    initial: Vec<f64>,
+}
+
+impl<P: ParticleModel> ParticleEffector<P> {
+    /// Wraps `model` with initial coordinates `q0` and rates `u0` (each length n).
+    pub fn new(name: impl Into<String>, model: P, q0: &[f64], u0: &[f64]) -> Self {
+        let n = model.num_coordinates();
+        assert!(n <= MAX_COORDINATES && q0.len() == n && u0.len() == n);
+        let mut initial = Vec::with_capacity(2 * n + 1);
+        initial.extend_from_slice(q0);
+        initial.extend_from_slice(u0);
+        initial.push(0.0);
+        ParticleEffector {
+            name: name.into(),
+            model,
+            initial,
+        }
+    }
+
+    /// The particle model.
+    pub fn model(&self) -> &P {
+        &self.model
+    }
+}
+
+fn cross_matrix(r: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
+}
+
+/// In-place Cholesky of the n × n leading block of `a` (row stride `MAX_COORDINATES`);
+/// returns false if not positive definite.
+fn cholesky(a: &mut [f64], n: usize) -> bool {
+    const S: usize = MAX_COORDINATES;
+    for j in 0..n {
+        let mut d = a[j * S + j];
+        for k in 0..j {
+            d -= a[j * S + k] * a[j * S + k];
+        }
+        if !(d > 0.0) {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * S + j] = d;
+        for i in j + 1..n {
+            let mut s = a[i * S + j];
+            for k in 0..j {
+                s -= a[i * S + k] * a[j * S + k];
+            }
+            a[i * S + j] = s / d;
+        }
+    }
+    true
+}
+
+/// Solves L Lᵀ x = b in place (`l` from [`cholesky`]).
+fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
+    const S: usize = MAX_COORDINATES;
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= l[i * S + k] * b[k];
+        }
+        b[i] = s / l[i * S + i];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= l[k * S + i] * b[k];
+        }
+        b[i] = s / l[i * S + i];
+    }
+}
+
+impl<P: ParticleModel> Effector for ParticleEffector<P> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn kind(&self) -> &'static str {
+        self.model.kind()
+    }
+    fn num_states(&self) -> usize {
+        2 * self.model.num_coordinates() + 1
+    }
+    fn num_dynamic_states(&self) -> usize {
+        2 * self.model.num_coordinates()
+    }
+    fn state_names(&self) -> Vec<String> {
+        let q = self.model.coordinate_names();
+        let mut names = q.clone();
+        names.extend(q.iter().map(|c| format!("{c}_rate")));
+        names.push("dissipated_energy".into());
+        names
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        self.initial.clone()
+    }
+    fn moves_mass(&self) -> bool {
+        true
+    }
+    fn scratch_len(&self) -> usize {
+        7 * self.model.num_coordinates()
+    }
+
+    fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
+        const S: usize = MAX_COORDINATES;
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let w = hub.omega;
+        let mut mass = [0.0; S * S];
+        // Cᵀ (n × 6), row-major with stride 6; g (n).
+        let mut ct = [0.0; S * 6];
+        let mut g = [0.0; S];
+        let mut d_rr = Matrix3::zeros();
+        let (mut m_sum, mut s_sum) = (0.0, Vector3::zeros());
+        let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
+        let mut pt = ParticlePoint::default();
+        for p in 0..self.model.num_particles() {
+            self.model.particle(p, q, u, &mut pt);
+            let m = pt.mass;
+            let r = pt.position;
+            let jac = &pt.jacobian[..n];
+            let mut v_rel = Vector3::zeros();
+            for (k, j) in jac.iter().enumerate() {
+                v_rel += j * u[k];
+            }
+            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
+            for k in 0..n {
+                let jk = jac[k];
+                for l in 0..=k {
+                    mass[k * S + l] += m * jk.dot(&jac[l]);
+                }
+                let rj = r.cross(&jk);
+                let row = &mut ct[k * 6..k * 6 + 6];
+                row[0] += m * jk.x;
+                row[1] += m * jk.y;
+                row[2] += m * jk.z;
+                row[3] += m * rj.x;
+                row[4] += m * rj.y;
+                row[5] += m * rj.z;
+                g[k] -= m * jk.dot(&c);
+            }
+            m_sum += m;
+            s_sum += m * r;
+            d_rr += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+            e_t += m * c;
+            e_r += m * r.cross(&c);
+        }
+        let mut forces = [0.0; S];
+        self.model.forces(q, u, &mut forces[..n]);
+        for k in 0..n {
+            g[k] += forces[k];
+            for l in 0..k {
+                mass[l * S + k] = mass[k * S + l];
+            }
+        }
+        // D and e.
+        let sx = cross_matrix(&s_sum);
+        for i in 0..3 {
+            coupling.mass[(i, i)] += m_sum;
+        }
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(0, 3);
+        block -= sx;
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 0);
+        block += sx;
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 3);
+        block += d_rr;
+        for i in 0..3 {
+            coupling.force[i] -= e_t[i];
+            coupling.force[3 + i] -= e_r[i];
+        }
+        coupling.translation = true;
+        if !cholesky(&mut mass, n) {
+            // A degenerate configuration: poison the hub solve, so the run stops with a
+            // diagnosis rather than continuing with nonsense.
+            coupling.force[0] = f64::NAN;
+            scratch.fill(f64::NAN);
+            return;
+        }
+        // Y = M⁻¹ Cᵀ (n × 6) and y_g = M⁻¹ g, kept for `derivatives`.
+        let (yg, y) = scratch.split_at_mut(n);
+        yg.copy_from_slice(&g[..n]);
+        cholesky_solve(&mass, n, yg);
+        let mut col = [0.0; S];
+        for c6 in 0..6 {
+            for k in 0..n {
+                col[k] = ct[k * 6 + c6];
+            }
+            cholesky_solve(&mass, n, &mut col[..n]);
+            for k in 0..n {
+                y[k * 6 + c6] = col[k];
+            }
+        }
+        // mass −= C Y ; force −= C y_g, with C = (Cᵀ)ᵀ.
+        for k in 0..n {
+            let ck = &ct[k * 6..k * 6 + 6];
+            let yk = &y[k * 6..k * 6 + 6];
+            for a in 0..6 {
+                coupling.force[a] -= ck[a] * yg[k];
+                for b in 0..6 {
+                    coupling.mass[(a, b)] -= ck[a] * yk[b];
+                }
+            }
+        }
+    }
+
+    fn derivatives(
+        &self,
+        hub: &HubState,
+        accel: &HubAcceleration,
+        x: &[f64],
+        scratch: &[f64],
+        dx: &mut [f64],
+    ) {
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let z = accel.as_vector6();
+        let (yg, y) = scratch.split_at(n);
+        dx[..n].copy_from_slice(u);
+        for k in 0..n {
+            let yk = &y[k * 6..k * 6 + 6];
+            let mut s = yg[k];
+            for a in 0..6 {
+                s -= yk[a] * z[a];
+            }
+            dx[n + k] = s;
+        }
+        dx[2 * n] = self.model.dissipation_power(q, u);
+        let _ = hub;
+    }
+
+    fn momentum(&self, hub: &HubState, x: &[f64]) -> Momentum {
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let mut out = Momentum::default();
+        let mut pt = ParticlePoint::default();
+        for p in 0..self.model.num_particles() {
+            self.model.particle(p, q, u, &mut pt);
+            let m = pt.mass;
+            let r = pt.position;
+            let mut v = hub.omega.cross(&r);
+            for (k, j) in pt.jacobian[..n].iter().enumerate() {
+                v += j * u[k];
+            }
+            out.mass += m;
+            out.first_moment += m * r;
+            out.linear += m * v;
+            out.angular += m * r.cross(&v);
+            out.kinetic_energy += 0.5 * m * v.norm_squared();
+        }
+        out
+    }
+
+    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        EnergyAccount {
+            elastic: self.model.elastic_energy(q),
+            dissipated: x[2 * n],
+            power: self.model.dissipation_power(q, u),
+        }
+    }
+
+    fn telemetry_names(&self) -> Vec<String> {
+        let mut names = self.state_names();
+        names.pop();
+        names.extend(
+            ["elastic_energy", "dissipated_energy", "dissipation_power"]
+                .iter()
+                .map(|s| s.to_string()),
+        );
+        names.extend(self.model.extra_telemetry_names());
+        names
+    }
+
+    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
+        let n = self.model.num_coordinates();
+        let a = self.energy(hub, x);
+        let mut v = x[..2 * n].to_vec();
+        v.extend([a.elastic, a.dissipated, a.power]);
+        v.extend(self.model.extra_telemetry(&x[..n]));
+        v
+    }
+
+    fn drawings(&self, x: &[f64]) -> Vec<Drawing> {
+        self.model.drawings(&x[..self.model.num_coordinates()])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solves_a_small_system() {
+        const S: usize = MAX_COORDINATES;
+        let mut a = [0.0; S * S];
+        let m = [[4.0, 2.0, 0.6], [2.0, 5.0, 1.0], [0.6, 1.0, 3.0]];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i * S + j] = m[i][j];
+            }
+        }
+        assert!(cholesky(&mut a, 3));
+        let mut b = [1.0, -2.0, 0.5];
+        cholesky_solve(&a, 3, &mut b);
+        for (i, row) in m.iter().enumerate() {
+            let r: f64 = row.iter().zip(&b).map(|(x, y)| x * y).sum();
+            assert!((r - [1.0, -2.0, 0.5][i]).abs() < 1e-14);
+        }
+        let mut singular = [0.0; S * S];
+        assert!(!cholesky(&mut singular, 2));
+    }
+}
