@@ -1,15 +1,28 @@
 //! Linearisation about steady spin: eigenvalues, growth or decay rates, time constants.
 //!
 //! The equilibrium is spin at rate Ω about the scenario's spin axis ŝ (which must be a
-//! principal axis of the hub, or no steady spin exists), with every effector at rest. The
-//! Jacobian of the rate dynamics (ω and effector states; the attitude does not feed back in a
-//! torque-free or internal-effector scene) is taken by central differences of the full
-//! right-hand side, so it covers whatever effectors the spacecraft has. For the rigid body the
-//! rate equations are quadratic, so central differences are exact up to rounding.
+//! principal axis of the whole spacecraft with its effectors at rest, or no steady spin
+//! exists), with every effector at rest. The Jacobian of the rate dynamics (ω and the
+//! effectors' dynamic states; the attitude does not feed back in a torque-free or
+//! internal-effector scene, and bookkeeping states such as dissipated energy are left out) is
+//! taken by central differences of the full right-hand side, so it covers whatever effectors
+//! the spacecraft has. For the rigid body the rate equations are quadratic, so central
+//! differences are exact up to rounding.
+//!
+//! The nutation mode is the eigenvalue nearest the rigid-body nutation eigenvalue of the
+//! spacecraft with its effectors locked; the others are the effectors' own modes. Beside the
+//! nutation rate this module gives the classic energy-sink estimate of it (physics.md): drive
+//! the effectors with the locked body's nutation motion, average the power they dissipate
+//! ⟨P⟩, and with |H| fixed let the excess energy ΔE = T − h²/(2 I_s) of the nutation decay
+//! (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is good for well-damped dampers only; the eigenvalue
+//! is the reference.
 
+use crate::effectors::EnergySink;
 use crate::integrate::OdeSystem;
-use crate::model::{HUB_STATES, Spacecraft};
-use nalgebra::{DMatrix, UnitQuaternion, Vector3};
+use crate::model::{HUB_STATES, RigidBody, Spacecraft};
+use nalgebra::{Complex, DMatrix, DVector, Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
+
+type C64 = Complex<f64>;
 
 /// One eigenvalue of the linearisation.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -21,8 +34,27 @@ pub struct Mode {
     /// `spin` (the neutral direction along ŝ), `growing`, `decaying`, `oscillating` or
     /// `neutral`.
     pub kind: String,
+    /// `spin`, `nutation` (the rigid body's wobble, modified by the effectors) or `effector`
+    /// (an effector's own mode: a damper's or an appendage's).
+    pub role: String,
     /// 1/|re| (s), when the mode grows or decays.
     pub time_constant: Option<f64>,
+}
+
+/// The nutation mode's rate and the energy-sink estimate of it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Nutation {
+    /// Growth (> 0) or decay (< 0) rate of the nutation amplitude from the eigenvalue (1/s).
+    pub rate: f64,
+    /// Its frequency in body axes (rad/s).
+    pub frequency: f64,
+    /// 1/|rate| (s).
+    pub time_constant: Option<f64>,
+    /// The energy-sink estimate of `rate` (1/s), when effectors with their own states
+    /// dissipate energy.
+    pub energy_sink_rate: Option<f64>,
+    /// 1/|energy_sink_rate| (s).
+    pub energy_sink_time_constant: Option<f64>,
 }
 
 /// The linearisation's result.
@@ -32,9 +64,10 @@ pub struct Linearization {
     pub spin_axis: [f64; 3],
     /// Spin rate Ω about it (rad/s).
     pub spin_rate: f64,
-    /// Which principal axis ŝ is (1 = minimum inertia … 3 = maximum).
+    /// Which principal axis ŝ is (1 = minimum inertia … 3 = maximum), of the whole spacecraft.
     pub principal_axis: usize,
-    /// Principal moments, ascending (kg m²).
+    /// Principal moments of the whole spacecraft with its effectors at rest and locked,
+    /// ascending (kg m²).
     pub principal_moments: [f64; 3],
     /// Jacobian (row-major) in the order of `state_names`.
     pub jacobian: Vec<Vec<f64>>,
@@ -46,10 +79,17 @@ pub struct Linearization {
     pub verdict: String,
     /// Largest real part among the non-spin modes (1/s).
     pub max_growth_rate: f64,
-    /// Predicted time constant of the nutation growth or decay, 1/|max_growth_rate| (s).
+    /// Predicted time constant of the fastest growth or slowest decay, 1/|max_growth_rate| (s).
     pub time_constant: Option<f64>,
-    /// The rigid-body closed form of physics.md for the same spin (an independent check):
-    /// growth rate k for the intermediate axis, nutation frequency otherwise.
+    /// The nutation mode, when one is identified.
+    pub nutation: Option<Nutation>,
+    /// Largest |ẏ| at the equilibrium relative to Ω (and 1 for effector states): near zero
+    /// when the effectors at rest are in equilibrium under the spin; a large value means the
+    /// linearisation is about a point that is not steady.
+    pub equilibrium_residual: f64,
+    /// The rigid-body closed form of physics.md for the same spin, effectors locked (an
+    /// independent check): growth rate k for the intermediate axis, nutation frequency
+    /// otherwise.
     pub rigid_body_prediction: RigidPrediction,
 }
 
@@ -62,25 +102,42 @@ pub struct RigidPrediction {
     pub frequency: f64,
 }
 
+/// Principal moments (ascending) and axes (columns) of a symmetric tensor.
+fn principal(i: &Matrix3<f64>) -> ([f64; 3], Matrix3<f64>) {
+    let e = SymmetricEigen::new(*i);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
+    let moments = order.map(|k| e.eigenvalues[k]);
+    let axes = Matrix3::from_columns(&order.map(|k| e.eigenvectors.column(k).into_owned()));
+    (moments, axes)
+}
+
 /// Linearises `sc` about steady spin at `spin_rate` (rad/s) about its spin axis.
 pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, String> {
+    if sc.motion().is_some() {
+        return Err("the hub's rotation is prescribed (`hub_motion`), so there is no free \
+                    steady spin to linearise about"
+            .into());
+    }
     let s = sc.spin_axis;
-    let p = sc.hub.principal_moments;
-    let axes = sc.hub.principal_axes;
-    let (principal, alignment) = (0..3)
+    let rest = sc.rest_state(&Vector3::zeros(), &UnitQuaternion::identity());
+    let inertia = sc.system_inertia(&rest);
+    let (p, axes) = principal(&inertia);
+    let (principal_index, alignment) = (0..3)
         .map(|c| (c, axes.column(c).dot(&s).abs()))
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap_or((2, 0.0));
     let misalignment = (1.0 - alignment.min(1.0)).max(0.0);
     if misalignment > 1e-9 {
-        let a = axes.column(principal);
+        let a = axes.column(principal_index);
         return Err(format!(
-            "the spin axis [{:.6}, {:.6}, {:.6}] is not a principal axis of the body (nearest: \
-             axis {} = [{:.6}, {:.6}, {:.6}], off by {:.3e}°), so no steady spin about it exists",
+            "the spin axis [{:.6}, {:.6}, {:.6}] is not a principal axis of the spacecraft \
+             (nearest: axis {} = [{:.6}, {:.6}, {:.6}], off by {:.3e}°), so no steady spin \
+             about it exists",
             s[0],
             s[1],
             s[2],
-            principal + 1,
+            principal_index + 1,
             a[0],
             a[1],
             a[2],
@@ -95,26 +152,34 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     }
 
     let omega = s * spin_rate;
-    let y_eq = sc.initial_state(&omega, &UnitQuaternion::identity());
+    let y_eq = sc.rest_state(&omega, &UnitQuaternion::identity());
     let n = sc.dim();
-    // Linearised coordinates: ω and effector states (the attitude is ignorable).
-    let idx: Vec<usize> = (0..3).chain(HUB_STATES..n).collect();
+    // Linearised coordinates: ω and the effectors' dynamic states.
+    let mut idx: Vec<usize> = (0..3).collect();
     let mut names: Vec<String> = ["omega_x", "omega_y", "omega_z"]
         .iter()
         .map(|s| s.to_string())
         .collect();
-    for e in sc.effectors() {
-        names.extend(
-            e.state_names()
-                .into_iter()
-                .map(|s| format!("{}.{s}", e.name())),
-        );
+    for (k, e) in sc.effectors().iter().enumerate() {
+        let off = sc.effector_offset(k);
+        let state_names = e.state_names();
+        for j in 0..e.num_dynamic_states() {
+            idx.push(off + j);
+            names.push(format!("{}.{}", e.name(), state_names[j]));
+        }
     }
+    let scale = spin_rate.abs();
+    let mut f0 = vec![0.0; n];
+    sc.rhs(0.0, &y_eq, &mut f0);
+    let equilibrium_residual = idx
+        .iter()
+        .map(|&i| if i < 3 { f0[i].abs() / (scale * scale) } else { f0[i].abs() })
+        .fold(0.0, f64::max);
     let m = idx.len();
     let mut jac = DMatrix::<f64>::zeros(m, m);
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    let h = 1e-6 * spin_rate.abs().max(1e-3);
     for (col, &j) in idx.iter().enumerate() {
+        let h = if j < HUB_STATES { 1e-6 * scale.max(1e-3) } else { 1e-6 };
         let mut yp = y_eq.clone();
         let mut ym = y_eq.clone();
         yp[j] += h;
@@ -126,8 +191,42 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         }
     }
     let eig = jac.clone().complex_eigenvalues();
-    let scale = spin_rate.abs();
     let zero = 1e-9 * scale;
+
+    // The locked body's nutation eigenvalue (physics.md closed forms with the composite
+    // moments), to pick out the nutation mode.
+    let (i1, i2, i3) = (p[0], p[1], p[2]);
+    let w = scale;
+    let rigid = match principal_index {
+        1 => RigidPrediction {
+            growth_rate: w * ((i3 - i2) * (i2 - i1) / (i1 * i3)).sqrt(),
+            frequency: 0.0,
+        },
+        0 => RigidPrediction {
+            growth_rate: 0.0,
+            frequency: w * ((i2 - i1) * (i3 - i1) / (i2 * i3)).sqrt(),
+        },
+        _ => RigidPrediction {
+            growth_rate: 0.0,
+            frequency: w * ((i3 - i1) * (i3 - i2) / (i1 * i2)).sqrt(),
+        },
+    };
+    let rigid_eigenvalue = C64::new(rigid.growth_rate, rigid.frequency);
+    let nutation_index = (rigid_eigenvalue.norm() > zero)
+        .then(|| {
+            eig.iter()
+                .enumerate()
+                .filter(|(_, z)| z.im >= 0.0 && z.norm() > zero)
+                .min_by(|a, b| {
+                    (a.1 - rigid_eigenvalue)
+                        .norm()
+                        .total_cmp(&(b.1 - rigid_eigenvalue).norm())
+                })
+                .map(|(k, _)| k)
+        })
+        .flatten();
+    let nutation_value = nutation_index.map(|k| eig[k]);
+
     // One zero eigenvalue belongs to the spin itself (a change of spin rate is steady too).
     // Further zero eigenvalues make the linearisation degenerate (e.g. a symmetric body spun
     // about a transverse axis): they are `neutral`, and the verdict says the linear theory
@@ -136,11 +235,13 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let mut modes: Vec<Mode> = eig
         .iter()
         .map(|z| {
+            let mut role = "effector";
             let kind = if z.norm() <= zero {
                 if spin_seen {
                     "neutral"
                 } else {
                     spin_seen = true;
+                    role = "spin";
                     "spin"
                 }
             } else if z.re > zero {
@@ -152,10 +253,17 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             } else {
                 "neutral"
             };
+            if let Some(v) = nutation_value
+                && (z.re - v.re).abs() <= 1e-12 * v.norm()
+                && (z.im.abs() - v.im.abs()).abs() <= 1e-12 * v.norm()
+            {
+                role = "nutation";
+            }
             Mode {
                 re: z.re,
                 im: z.im,
                 kind: kind.into(),
+                role: role.into(),
                 time_constant: (z.re.abs() > zero).then(|| 1.0 / z.re.abs()),
             }
         })
@@ -178,26 +286,26 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     } else {
         "marginally stable (oscillatory)"
     };
-    let (i1, i2, i3) = (p[0], p[1], p[2]);
-    let w = spin_rate.abs();
-    let rigid = match principal {
-        1 => RigidPrediction {
-            growth_rate: w * ((i3 - i2) * (i2 - i1) / (i1 * i3)).sqrt(),
-            frequency: 0.0,
-        },
-        0 => RigidPrediction {
-            growth_rate: 0.0,
-            frequency: w * ((i2 - i1) * (i3 - i1) / (i2 * i3)).sqrt(),
-        },
-        _ => RigidPrediction {
-            growth_rate: 0.0,
-            frequency: w * ((i3 - i1) * (i3 - i2) / (i1 * i2)).sqrt(),
-        },
-    };
+
+    let nutation = nutation_value.map(|v| {
+        let estimate = (rigid.frequency > 0.0)
+            .then(|| energy_sink_estimate(sc, &y_eq, &idx, &inertia, &s, rigid.frequency))
+            .flatten();
+        Nutation {
+            rate: v.re,
+            frequency: v.im.abs(),
+            time_constant: (v.re.abs() > zero).then(|| 1.0 / v.re.abs()),
+            energy_sink_rate: estimate,
+            energy_sink_time_constant: estimate
+                .filter(|r| r.abs() > 0.0)
+                .map(|r| 1.0 / r.abs()),
+        }
+    });
+
     Ok(Linearization {
         spin_axis: [s[0], s[1], s[2]],
         spin_rate,
-        principal_axis: principal + 1,
+        principal_axis: principal_index + 1,
         principal_moments: [i1, i2, i3],
         jacobian: (0..m)
             .map(|r| (0..m).map(|c| jac[(r, c)]).collect())
@@ -207,8 +315,202 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         verdict: verdict.into(),
         max_growth_rate,
         time_constant: (max_growth_rate.abs() > zero).then(|| 1.0 / max_growth_rate.abs()),
+        nutation,
+        equilibrium_residual,
         rigid_body_prediction: rigid,
     })
+}
+
+/// The energy-sink estimate of the nutation rate (1/s), or `None` when no effector with
+/// states dissipates. `idx` lists ω then the effectors' dynamic states.
+fn energy_sink_estimate(
+    sc: &Spacecraft,
+    y_eq: &[f64],
+    idx: &[usize],
+    inertia: &Matrix3<f64>,
+    spin_axis: &Vector3<f64>,
+    nu: f64,
+) -> Option<f64> {
+    let x_idx = &idx[3..];
+    let nx = x_idx.len();
+    if nx == 0 {
+        return None;
+    }
+    let n = sc.dim();
+    let omega_eq = Vector3::new(y_eq[0], y_eq[1], y_eq[2]);
+    // The locked body's nutation mode: δω̇ = A δω, A = I⁻¹([h×] − [Ω×] I).
+    let cross = |v: &Vector3<f64>| Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0);
+    let inv = inertia.try_inverse()?;
+    let a = inv * (cross(&(inertia * omega_eq)) - cross(&omega_eq) * inertia);
+    let lambda = C64::new(0.0, nu);
+    let shifted = a.map(|x| C64::new(x, 0.0)) - Matrix3::identity().map(|x| C64::new(x, 0.0)) * lambda;
+    // Null vector of the rank-2 matrix: the cross product of two independent rows.
+    let rows: Vec<[C64; 3]> = (0..3)
+        .map(|r| [shifted[(r, 0)], shifted[(r, 1)], shifted[(r, 2)]])
+        .collect();
+    let cross_c = |u: &[C64; 3], w: &[C64; 3]| {
+        [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ]
+    };
+    let v = [(0, 1), (0, 2), (1, 2)]
+        .iter()
+        .map(|&(i, j)| cross_c(&rows[i], &rows[j]))
+        .max_by(|x, y| {
+            let nx: f64 = x.iter().map(|c| c.norm_sqr()).sum();
+            let ny: f64 = y.iter().map(|c| c.norm_sqr()).sum();
+            nx.total_cmp(&ny)
+        })?;
+
+    // Jacobians of the effectors' rates with the hub's rotation prescribed (translation free).
+    let f = |y: &[f64], wd: &Vector3<f64>, out: &mut Vec<f64>| {
+        let mut dy = vec![0.0; n];
+        sc.rhs_prescribed(0.0, y, wd, true, &mut dy);
+        out.clear();
+        out.extend(x_idx.iter().map(|&i| dy[i]));
+    };
+    let mut a_xx = DMatrix::<f64>::zeros(nx, nx);
+    let mut b_w = DMatrix::<f64>::zeros(nx, 3);
+    let mut b_wd = DMatrix::<f64>::zeros(nx, 3);
+    let (mut fp, mut fm) = (Vec::new(), Vec::new());
+    let zero3 = Vector3::zeros();
+    let h = 1e-6;
+    for (c, &j) in x_idx.iter().enumerate() {
+        let mut yp = y_eq.to_vec();
+        let mut ym = y_eq.to_vec();
+        yp[j] += h;
+        ym[j] -= h;
+        f(&yp, &zero3, &mut fp);
+        f(&ym, &zero3, &mut fm);
+        for r in 0..nx {
+            a_xx[(r, c)] = (fp[r] - fm[r]) / (2.0 * h);
+        }
+    }
+    let hw = 1e-6 * omega_eq.norm().max(1e-3);
+    for c in 0..3 {
+        let mut yp = y_eq.to_vec();
+        let mut ym = y_eq.to_vec();
+        yp[c] += hw;
+        ym[c] -= hw;
+        f(&yp, &zero3, &mut fp);
+        f(&ym, &zero3, &mut fm);
+        for r in 0..nx {
+            b_w[(r, c)] = (fp[r] - fm[r]) / (2.0 * hw);
+        }
+        let e = Vector3::ith(c, hw);
+        f(y_eq, &e, &mut fp);
+        f(y_eq, &(-e), &mut fm);
+        for r in 0..nx {
+            b_wd[(r, c)] = (fp[r] - fm[r]) / (2.0 * hw);
+        }
+    }
+    // Steady response X = (iν − A_xx)⁻¹ (B_ω + iν B_ω̇) v.
+    let vv = DVector::from_iterator(3, v.iter().copied());
+    let lhs = DMatrix::<C64>::identity(nx, nx) * lambda - a_xx.map(|x| C64::new(x, 0.0));
+    let rhs = (b_w.map(|x| C64::new(x, 0.0)) + b_wd.map(|x| C64::new(x, 0.0)) * lambda) * vv;
+    let x = lhs.lu().solve(&rhs)?;
+
+    // Dissipation power as a quadratic form in the states: its Hessian D.
+    let power = |y: &[f64]| sc.invariants(0.0, y).dissipation_power;
+    let mut d = DMatrix::<f64>::zeros(nx, nx);
+    let hp = 1e-4;
+    for (r, &i) in x_idx.iter().enumerate() {
+        for (c, &j) in x_idx.iter().enumerate().skip(r) {
+            let mut val = 0.0;
+            for (si, sj, sign) in [(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)] {
+                let mut y = y_eq.to_vec();
+                y[i] += si * hp;
+                y[j] += sj * hp;
+                val += sign * power(&y);
+            }
+            d[(r, c)] = val / (4.0 * hp * hp);
+            d[(c, r)] = d[(r, c)];
+        }
+    }
+    if d.amax() == 0.0 {
+        return None;
+    }
+    // ⟨P⟩ = ¼ Re(Xᴴ D X) for x(t) = Re(X e^{iνt}).
+    let dx = d.map(|x| C64::new(x, 0.0)) * &x;
+    let mean_power = 0.25 * x.iter().zip(dx.iter()).map(|(a, b)| (a.conj() * b).re).sum::<f64>();
+    // ⟨ΔE⟩ = ½ Σ I_i (1 − I_i/I_s) ⟨δω_i²⟩, ⟨δω_i²⟩ = ½|v_i|², in principal axes.
+    let (moments, axes) = principal(inertia);
+    let i_s = spin_axis.dot(&(inertia * spin_axis));
+    let mut mean_excess = 0.0;
+    for k in 0..3 {
+        let col = axes.column(k);
+        let vk: C64 = (0..3).map(|r| v[r] * col[r]).sum();
+        mean_excess += 0.5 * moments[k] * (1.0 - moments[k] / i_s) * 0.5 * vk.norm_sqr();
+    }
+    if mean_excess == 0.0 {
+        return None;
+    }
+    Some(-mean_power / (2.0 * mean_excess))
+}
+
+/// The energy-sink coefficient c (N m s/rad) that makes the nutation of `hub` spinning at
+/// `spin_rate` about `spin_axis` grow (minor axis) or decay (major axis) with time constant
+/// `tau` (s), from the linearisation.
+pub fn energy_sink_coefficient(
+    hub: &RigidBody,
+    spin_axis: Vector3<f64>,
+    spin_rate: f64,
+    tau: f64,
+) -> Result<f64, String> {
+    let rate_for = |c: f64| -> Result<f64, String> {
+        let mut sc = Spacecraft::new(hub.clone(), spin_axis);
+        sc.add_effector(Box::new(EnergySink {
+            name: "sink".into(),
+            coefficient: c,
+            inertia: hub.inertia,
+        }))
+        .map_err(|e| e.to_string())?;
+        let lin = linearize(&sc, spin_rate)?;
+        lin.nutation
+            .map(|n| n.rate.abs())
+            .ok_or_else(|| "no nutation mode about this spin (an intermediate axis?)".to_string())
+    };
+    if !(tau.is_finite() && tau > 0.0) {
+        return Err(format!("expected a positive time constant, got {tau}"));
+    }
+    let target = 1.0 / tau;
+    // Scan c over decades (in units of I_s |Ω|) for the first bracket, then bisect in log c.
+    let i_s = spin_axis.dot(&(hub.inertia * spin_axis));
+    let unit = i_s * spin_rate.abs();
+    let (mut lo, mut hi) = (None, None);
+    let mut c = 1e-12 * unit;
+    let mut best: f64 = 0.0;
+    while c < 1e12 * unit {
+        let r = rate_for(c)?;
+        best = best.max(r);
+        if r >= target {
+            hi = Some(c);
+            break;
+        }
+        lo = Some(c);
+        c *= 10.0;
+    }
+    let (Some(mut lo), Some(mut hi)) = (lo, hi) else {
+        return Err(format!(
+            "no energy-sink coefficient gives a nutation time constant of {tau} s about this \
+             spin (the shortest reachable is {:.4e} s)",
+            1.0 / best.max(f64::MIN_POSITIVE)
+        ));
+    };
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if rate_for(mid)? < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi / lo - 1.0 < 1e-13 {
+            break;
+        }
+    }
+    Ok((lo * hi).sqrt())
 }
 
 /// The spin rate about the spin axis implied by the initial rates: `ω₀ · ŝ` (rad/s).
@@ -272,6 +574,86 @@ mod tests {
         assert_eq!(lin.modes.iter().filter(|m| m.kind == "spin").count(), 1);
         assert!(lin.max_growth_rate.is_finite());
         assert_eq!(lin.time_constant, None);
+    }
+
+    use crate::effectors::{ParticleEffector, SpringMass, WheelDamper};
+
+    /// validation.md: Kasdin–Paley wheel damper, I_S/I_T = 1.5, I_W/I_T = 0.06, D/I_T = 0.5,
+    /// n = 2 rad/s: −0.010689 ± 1.001151i and −8.843869.
+    #[test]
+    fn kasdin_paley_wheel_damper_eigenvalues() {
+        let hub = RigidBody::from_principal([1.0, 1.5, 1.0]).unwrap();
+        let mut sc = Spacecraft::new(hub, Vector3::y());
+        sc.add_effector(Box::new(WheelDamper {
+            name: "wheel".into(),
+            inertia: 0.06,
+            axis: Vector3::z(),
+            damping: 0.5,
+            initial_rate: 0.0,
+            position: Vector3::zeros(),
+        }))
+        .unwrap();
+        let lin = linearize(&sc, 2.0).unwrap();
+        let nut = lin.nutation.clone().unwrap();
+        assert_relative_eq!(nut.rate, -0.010689, max_relative = 5e-5);
+        assert_relative_eq!(nut.frequency, 1.001151, max_relative = 5e-7);
+        let real = lin
+            .modes
+            .iter()
+            .find(|m| m.role == "effector" && m.im == 0.0)
+            .unwrap();
+        assert_relative_eq!(real.re, -8.843869, max_relative = 5e-7);
+        assert_eq!(lin.verdict, "asymptotically stable");
+        assert!(lin.equilibrium_residual < 1e-15);
+    }
+
+    /// validation.md: axial spring–mass damper, spin 1 rad/s about z, reduced mass 5 kg at
+    /// e = 1 m, k = 0.8 N/m, c = 5 N s/m, composite inertia diag(1000, 1000, I_s).
+    fn axial_damper(i_s: f64) -> Spacecraft {
+        let mu = 5.0;
+        let hub = RigidBody::from_principal([1000.0, 1000.0 - mu, i_s - mu]).unwrap();
+        let mut sc = Spacecraft::new(hub, Vector3::z());
+        // m = M = 10 kg gives μ = 5 kg.
+        sc.hub_mass = Some(10.0);
+        let smd = SpringMass {
+            mass: 10.0,
+            position: Vector3::x(),
+            direction: Vector3::z(),
+            stiffness: 0.8,
+            damping: 5.0,
+        };
+        sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0])))
+            .unwrap();
+        sc
+    }
+
+    #[test]
+    fn axial_spring_mass_damper_rates_and_energy_sink_estimates() {
+        for (i_s, rate, sink) in [(1400.0, -3.167e-3, -3.150e-3), (600.0, 7.238e-3, 7.35e-3)] {
+            let lin = linearize(&axial_damper(i_s), 1.0).unwrap();
+            // The composite (not the hub's) moments: diag(1000, 1000, I_s).
+            let mut expected = [1000.0, 1000.0, i_s];
+            expected.sort_by(f64::total_cmp);
+            for (got, want) in lin.principal_moments.iter().zip(expected) {
+                assert_relative_eq!(*got, want, max_relative = 1e-12);
+            }
+            let nut = lin.nutation.unwrap();
+            assert_relative_eq!(nut.rate, rate, max_relative = 2e-4);
+            let es = nut.energy_sink_rate.unwrap();
+            assert_relative_eq!(es, sink, max_relative = 1e-3);
+        }
+    }
+
+    /// Axisymmetric body with an energy sink: the transverse equations give
+    /// σ = −c (1 − I_t/I_s) / I_t exactly; the solved coefficient must reproduce τ.
+    #[test]
+    fn energy_sink_coefficient_hits_the_time_constant() {
+        let (i_t, i_s) = (5.0, 2.0);
+        let hub = RigidBody::from_principal([i_t, i_t, i_s]).unwrap();
+        let tau = 1200.0;
+        let c = energy_sink_coefficient(&hub, Vector3::z(), 30.0, tau).unwrap();
+        let expected = i_t / (tau * (1.0 - i_t / i_s).abs());
+        assert_relative_eq!(c, expected, max_relative = 1e-8);
     }
 
     #[test]

@@ -5,8 +5,11 @@
 //! checks physics and ranges, using the spans kept on every checked field, and produces a
 //! [`Scenario`] ready to run.
 
+mod effectors;
 mod error;
 mod time;
+
+pub use effectors::{EffectorSpec, HubMotionSpec};
 
 pub use error::{ScenarioError, field_path_at, nearest};
 pub use time::{LAST_LOG_SECOND, format_epoch, parse_epoch};
@@ -55,12 +58,21 @@ pub struct ScenarioFile {
     /// Conditions recorded every time they become true, without stopping.
     #[serde(default)]
     pub events: Vec<Spanned<ConditionSpec>>,
+    /// Parts beyond the rigid hub: dampers, appendages, dissipation torques.
+    #[serde(default)]
+    pub effectors: Vec<EffectorSpec>,
+    /// A prescribed hub rotation (the hub's centre of mass is then pinned).
+    #[serde(default)]
+    pub hub_motion: Option<HubMotionSpec>,
 }
 
 /// `body:` mass properties and display.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
+    /// Hub mass (kg), excluding effectors that move mass; needed when there are such.
+    #[serde(default)]
+    pub mass: Option<Spanned<f64>>,
     /// Full inertia tensor about the centre of mass, body axes (kg m², rows).
     #[serde(default)]
     pub inertia: Option<Spanned<[[f64; 3]; 3]>>,
@@ -922,13 +934,53 @@ impl ScenarioFile {
             Some(s) => shape(path, s)?,
         };
 
+        let mut spacecraft = Spacecraft::new(hub, spin_axis);
+        if let Some(m) = &self.body.mass {
+            if !(m.value.is_finite() && m.value > 0.0) {
+                return Err(err(
+                    loc(m),
+                    "body.mass",
+                    format!("expected a positive, finite mass (kg), got {}", m.value),
+                ));
+            }
+            spacecraft.hub_mass = Some(m.value);
+        }
+        let cx = effectors::Context {
+            path,
+            hub: &spacecraft.hub,
+            shape: &shape,
+            spin_axis,
+            omega0,
+        };
+        for e in effectors::build(&cx, &self.effectors)? {
+            spacecraft.add_effector(e).map_err(|e| {
+                err(
+                    self.body.mass.as_ref().and_then(loc),
+                    "body.mass",
+                    e.to_string(),
+                )
+            })?;
+        }
+        if let Some(m) = &self.hub_motion {
+            spacecraft.set_motion(Box::new(effectors::motion(path, m)?));
+        }
+        if matches!(method, Method::Exact) && !spacecraft.effectors().is_empty() {
+            return Err(err(
+                method_loc,
+                if ov.method.is_some() { "--method" } else { "integrator.method" },
+                "method `exact` solves the torque-free rigid body only, and this spacecraft \
+                 has effectors; use dopri5 or rk4"
+                    .into(),
+            ));
+        }
+
         Ok(Scenario {
             path: path.to_path_buf(),
             source,
             name,
             description: self.description.unwrap_or_default(),
             epoch_unix_ns,
-            spacecraft: Spacecraft::new(hub, spin_axis),
+            spacecraft,
             omega0,
             attitude0,
             duration,

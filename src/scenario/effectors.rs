@@ -1,0 +1,721 @@
+//! `effectors:` and `hub_motion:` in the scenario file: specs, validation, and construction.
+//!
+//! Each list item is a one-key mapping naming the kind, e.g. `- hinged_rod: {mass: 0.139, …}`.
+//! Every physical parameter keeps its span, so an unphysical value is reported at its line.
+
+use super::{ScenarioError, Shape, loc};
+use crate::effectors::beam::{BeamProperties, beam_modes};
+use crate::effectors::{
+    EnergySink, HingeFreedom, HingedRod, ModalBeam, ParticleEffector, Rayleigh, SpinUp,
+    SpringMass, WheelDamper,
+};
+use crate::model::{Effector, RigidBody};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use serde::Deserialize;
+use serde_saphyr::Spanned;
+use std::path::Path;
+
+/// One entry of `effectors:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum EffectorSpec {
+    /// Rayleigh dissipation torque −Γω.
+    Rayleigh(RayleighSpec),
+    /// Quasi-rigid energy-sink torque.
+    EnergySink(EnergySinkSpec),
+    /// Particle on a line with spring and dashpot.
+    SpringMassDamper(SpringMassSpec),
+    /// Viscous wheel damper.
+    WheelDamper(WheelSpec),
+    /// Rigid rod on a hinge.
+    HingedRod(HingedRodSpec),
+    /// Modal cantilever beam.
+    ModalAppendage(ModalSpec),
+}
+
+/// `rayleigh:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RayleighSpec {
+    /// Name (default `rayleigh`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Γ as a full symmetric matrix (N m s/rad, body axes, rows).
+    #[serde(default)]
+    pub gamma: Option<Spanned<[[f64; 3]; 3]>>,
+    /// Γ as a diagonal (N m s/rad), instead of `gamma`.
+    #[serde(default)]
+    pub gamma_diagonal: Option<Spanned<[f64; 3]>>,
+}
+
+/// `energy_sink:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnergySinkSpec {
+    /// Name (default `energy_sink`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Coefficient c (N m s/rad).
+    #[serde(default)]
+    pub coefficient: Option<Spanned<f64>>,
+    /// Target nutation time constant (s), instead of `coefficient`: c is solved so that the
+    /// linearised nutation mode about the initial spin grows or decays as e^{±t/τ}.
+    #[serde(default)]
+    pub time_constant: Option<Spanned<f64>>,
+}
+
+/// `spring_mass_damper:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringMassSpec {
+    /// Name (default `spring_mass_damper`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Particle mass (kg).
+    pub mass: Spanned<f64>,
+    /// Point of the line at zero offset (m, body axes, about the hub's centre of mass).
+    pub position: Spanned<[f64; 3]>,
+    /// Direction of the line (body axes).
+    pub direction: Spanned<[f64; 3]>,
+    /// Spring stiffness (N/m).
+    pub stiffness: Spanned<f64>,
+    /// Dashpot coefficient (N s/m).
+    pub damping: Spanned<f64>,
+    /// Initial offset (m).
+    #[serde(default)]
+    pub initial_offset: Option<Spanned<f64>>,
+    /// Initial rate (m/s).
+    #[serde(default)]
+    pub initial_rate: Option<Spanned<f64>>,
+}
+
+/// `wheel_damper:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WheelSpec {
+    /// Name (default `wheel_damper`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Rotor axial inertia (kg m²), included in `body` as if locked.
+    pub inertia: Spanned<f64>,
+    /// Rotor axis (body axes).
+    pub axis: Spanned<[f64; 3]>,
+    /// Viscous coefficient (N m s/rad).
+    pub damping: Spanned<f64>,
+    /// Initial rotor rate relative to the body (rad/s).
+    #[serde(default)]
+    pub initial_rate: Option<Spanned<f64>>,
+    /// Where to draw it (m, body axes).
+    #[serde(default)]
+    pub position: Option<Spanned<[f64; 3]>>,
+}
+
+/// A scalar applied to both hinge angles, or `[flap, lag]`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+pub enum PerAngle {
+    /// The same value for flap and lag.
+    Both(f64),
+    /// `[flap, lag]`.
+    Each([f64; 2]),
+}
+
+impl PerAngle {
+    fn pair(self) -> [f64; 2] {
+        match self {
+            PerAngle::Both(x) => [x, x],
+            PerAngle::Each(p) => p,
+        }
+    }
+}
+
+/// `copies: {count: 4, about: [0, 0, 1]}`: identical copies turned evenly about a body axis
+/// through the hub's centre of mass (e.g. turnstile antennas).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CopiesSpec {
+    /// Number of copies (≥ 1), the first as written.
+    pub count: Spanned<u32>,
+    /// Axis they are turned about (body axes).
+    pub about: Spanned<[f64; 3]>,
+}
+
+/// `hinged_rod:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HingedRodSpec {
+    /// Name (default `hinged_rod`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Rod mass (kg).
+    pub mass: Spanned<f64>,
+    /// Rod length (m).
+    pub length: Spanned<f64>,
+    /// Hinge point (m, body axes, about the hub's centre of mass); must be on or in the body.
+    pub hinge: Spanned<[f64; 3]>,
+    /// Rest direction of the rod (body axes).
+    pub direction: Spanned<[f64; 3]>,
+    /// Hinge axis (⊥ direction): lag turns about it, flap tips toward it.
+    pub axis: Spanned<[f64; 3]>,
+    /// `flap_lag` (default), `flap` or `lag`.
+    #[serde(default)]
+    pub freedom: Option<Spanned<String>>,
+    /// Torsional stiffness (N m/rad), one value or `[flap, lag]`.
+    pub stiffness: Spanned<PerAngle>,
+    /// Torsional damping (N m s/rad), one value or `[flap, lag]`.
+    pub damping: Spanned<PerAngle>,
+    /// Initial `[flap, lag]` angles (rad).
+    #[serde(default)]
+    pub initial_angles: Option<Spanned<[f64; 2]>>,
+    /// Initial `[flap, lag]` rates (rad/s).
+    #[serde(default)]
+    pub initial_rates: Option<Spanned<[f64; 2]>>,
+    /// Copies turned about an axis.
+    #[serde(default)]
+    pub copies: Option<CopiesSpec>,
+}
+
+/// `modal_appendage:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModalSpec {
+    /// Name (default `modal_appendage`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Beam length (m).
+    pub length: Spanned<f64>,
+    /// Bending stiffness EI (N m²).
+    pub bending_stiffness: Spanned<f64>,
+    /// Mass per unit length ρA (kg/m).
+    pub mass_per_length: Spanned<f64>,
+    /// Tip mass (kg).
+    #[serde(default)]
+    pub tip_mass: Option<Spanned<f64>>,
+    /// Root point (m, body axes, about the hub's centre of mass); must be on or in the body.
+    pub attachment: Spanned<[f64; 3]>,
+    /// Beam direction (body axes).
+    pub direction: Spanned<[f64; 3]>,
+    /// First bending direction `flap` (⊥ direction); `lag` is direction × flap.
+    pub flap_direction: Spanned<[f64; 3]>,
+    /// `both` (default), `flap` or `lag`.
+    #[serde(default)]
+    pub bending: Option<Spanned<String>>,
+    /// Number of modes per bending direction (1–10, default 3).
+    #[serde(default)]
+    pub modes: Option<Spanned<u32>>,
+    /// Modal damping ratio ζ (default 0.005).
+    #[serde(default)]
+    pub damping_ratio: Option<Spanned<f64>>,
+    /// Model the foreshortening that stiffens a spun beam (default true).
+    #[serde(default)]
+    pub geometric_stiffening: Option<bool>,
+    /// Initial tip deflection along flap and lag (m), in the first mode's shape.
+    #[serde(default)]
+    pub initial_tip_deflection: Option<Spanned<[f64; 2]>>,
+    /// Copies turned about an axis.
+    #[serde(default)]
+    pub copies: Option<CopiesSpec>,
+}
+
+/// `hub_motion:`: a prescribed hub rotation.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum HubMotionSpec {
+    /// The smooth spin-up of physics.md.
+    SpinUp {
+        /// Spin axis (body axes).
+        axis: Spanned<[f64; 3]>,
+        /// Final rate (rad/s).
+        rate: Spanned<f64>,
+        /// Ramp duration (s).
+        ramp_time: Spanned<f64>,
+    },
+}
+
+/// Builds located errors for one effector entry.
+struct Check<'a> {
+    path: &'a Path,
+    prefix: String,
+}
+
+impl Check<'_> {
+    fn err<T>(&self, s: &Spanned<T>, key: &str, msg: impl Into<String>) -> ScenarioError {
+        ScenarioError::at(self.path, loc(s), format!("{}.{key}", self.prefix), msg)
+    }
+    fn positive(&self, s: &Spanned<f64>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
+        let v = s.value;
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(s, key, format!("expected a positive, finite value ({unit}), got {v}")))
+        }
+    }
+    fn non_negative(
+        &self,
+        s: &Spanned<f64>,
+        key: &str,
+        unit: &str,
+    ) -> Result<f64, ScenarioError> {
+        let v = s.value;
+        if v.is_finite() && v >= 0.0 {
+            Ok(v)
+        } else {
+            Err(self.err(s, key, format!("expected a finite value ≥ 0 ({unit}), got {v}")))
+        }
+    }
+    fn finite(&self, s: &Option<Spanned<f64>>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
+        match s {
+            None => Ok(0.0),
+            Some(x) if x.value.is_finite() => Ok(x.value),
+            Some(x) => Err(self.err(x, key, format!("expected a finite value ({unit})"))),
+        }
+    }
+    fn point(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
+        if s.value.iter().all(|x| x.is_finite()) {
+            Ok(Vector3::from(s.value))
+        } else {
+            Err(self.err(s, key, "expected three finite numbers (m, body axes)"))
+        }
+    }
+    fn unit(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
+        let v = Vector3::from(s.value);
+        if v.iter().all(|x| x.is_finite()) && v.norm() > 0.0 {
+            Ok(v.normalize())
+        } else {
+            Err(self.err(s, key, "expected a non-zero vector of three finite numbers"))
+        }
+    }
+    fn perpendicular(
+        &self,
+        s: &Spanned<[f64; 3]>,
+        key: &str,
+        to: &Vector3<f64>,
+        to_key: &str,
+    ) -> Result<Vector3<f64>, ScenarioError> {
+        let v = self.unit(s, key)?;
+        let c = v.dot(to);
+        if c.abs() > 1e-6 {
+            return Err(self.err(
+                s,
+                key,
+                format!(
+                    "expected a direction perpendicular to `{to_key}`; the angle between them \
+                     is {:.4}°",
+                    c.clamp(-1.0, 1.0).acos().to_degrees()
+                ),
+            ));
+        }
+        // Remove the rounding-level component, so the frame is orthonormal to 1e-16.
+        Ok((v - c * to).normalize())
+    }
+    fn on_body(
+        &self,
+        s: &Spanned<[f64; 3]>,
+        key: &str,
+        shape: &Shape,
+    ) -> Result<Vector3<f64>, ScenarioError> {
+        let p = self.point(s, key)?;
+        if let Some(excess) = outside(shape, &p) {
+            return Err(self.err(
+                s,
+                key,
+                format!(
+                    "the point [{}, {}, {}] m is outside the body by {excess:.4} m: it must be \
+                     on or inside the hub's shape (`body.shape`, or the box equivalent to the \
+                     inertia when no shape is given)",
+                    p[0], p[1], p[2]
+                ),
+            ));
+        }
+        Ok(p)
+    }
+    fn copies(&self, c: &Option<CopiesSpec>) -> Result<Vec<UnitQuaternion<f64>>, ScenarioError> {
+        let Some(c) = c else {
+            return Ok(vec![UnitQuaternion::identity()]);
+        };
+        let n = c.count.value;
+        if !(1..=64).contains(&n) {
+            return Err(self.err(&c.count, "copies.count", "expected a count from 1 to 64"));
+        }
+        let axis = self.unit(&c.about, "copies.about")?;
+        let axis = nalgebra::Unit::new_normalize(axis);
+        Ok((0..n)
+            .map(|k| {
+                UnitQuaternion::from_axis_angle(
+                    &axis,
+                    2.0 * std::f64::consts::PI * k as f64 / n as f64,
+                )
+            })
+            .collect())
+    }
+}
+
+/// How far `p` lies outside `shape` (m), or `None` if on or inside (with a 1e-9 relative
+/// allowance for points given on the surface).
+fn outside(shape: &Shape, p: &Vector3<f64>) -> Option<f64> {
+    let (local, excess) = match shape {
+        Shape::Box { size, orientation } => {
+            let l = orientation.inverse() * p;
+            let e = (0..3)
+                .map(|i| l[i].abs() - 0.5 * size[i])
+                .fold(f64::NEG_INFINITY, f64::max);
+            (size.max(), e)
+        }
+        Shape::Cylinder {
+            radius,
+            length,
+            orientation,
+        } => {
+            let l = orientation.inverse() * p;
+            let radial = (l.x * l.x + l.y * l.y).sqrt() - radius;
+            let axial = l.z.abs() - 0.5 * length;
+            (length.max(2.0 * radius), radial.max(axial))
+        }
+    };
+    (excess > 1e-9 * local).then_some(excess)
+}
+
+/// Everything needed to build effectors: the file, the hub, and the initial spin.
+pub(super) struct Context<'a> {
+    pub path: &'a Path,
+    pub hub: &'a RigidBody,
+    pub shape: &'a Shape,
+    pub spin_axis: Vector3<f64>,
+    pub omega0: Vector3<f64>,
+}
+
+/// Validates `effectors:` and builds them, in order.
+pub(super) fn build(
+    cx: &Context,
+    specs: &[EffectorSpec],
+) -> Result<Vec<Box<dyn Effector>>, ScenarioError> {
+    let mut out: Vec<Box<dyn Effector>> = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        let kind = match spec {
+            EffectorSpec::Rayleigh(_) => "rayleigh",
+            EffectorSpec::EnergySink(_) => "energy_sink",
+            EffectorSpec::SpringMassDamper(_) => "spring_mass_damper",
+            EffectorSpec::WheelDamper(_) => "wheel_damper",
+            EffectorSpec::HingedRod(_) => "hinged_rod",
+            EffectorSpec::ModalAppendage(_) => "modal_appendage",
+        };
+        let ck = Check {
+            path: cx.path,
+            prefix: format!("effectors[{i}].{kind}"),
+        };
+        let name_of = |n: &Option<String>| {
+            n.clone()
+                .filter(|s| !s.trim().is_empty())
+                .unwrap_or_else(|| {
+                    if specs.len() > 1 {
+                        format!("{kind}_{}", i + 1)
+                    } else {
+                        kind.to_string()
+                    }
+                })
+        };
+        match spec {
+            EffectorSpec::Rayleigh(r) => {
+                let gamma = match (&r.gamma, &r.gamma_diagonal) {
+                    (Some(g), None) => {
+                        let m = Matrix3::from_row_slice(&g.value.concat());
+                        check_psd(&ck, g, "gamma", &m)?;
+                        m
+                    }
+                    (None, Some(d)) => {
+                        let m = Matrix3::from_diagonal(&Vector3::from(d.value));
+                        check_psd(&ck, d, "gamma_diagonal", &m)?;
+                        m
+                    }
+                    _ => {
+                        return Err(ScenarioError::at(
+                            cx.path,
+                            None,
+                            ck.prefix.clone(),
+                            "expected exactly one of `gamma: [[..],[..],[..]]` or \
+                             `gamma_diagonal: [g1, g2, g3]` (N m s/rad)",
+                        ));
+                    }
+                };
+                out.push(Box::new(Rayleigh {
+                    name: name_of(&r.name),
+                    gamma,
+                }));
+            }
+            EffectorSpec::EnergySink(e) => {
+                let coefficient = match (&e.coefficient, &e.time_constant) {
+                    (Some(c), None) => ck.positive(c, "coefficient", "N m s/rad")?,
+                    (None, Some(t)) => {
+                        let tau = ck.positive(t, "time_constant", "s")?;
+                        crate::linearize::energy_sink_coefficient(
+                            cx.hub,
+                            cx.spin_axis,
+                            cx.omega0.dot(&cx.spin_axis),
+                            tau,
+                        )
+                        .map_err(|m| ck.err(t, "time_constant", m))?
+                    }
+                    _ => {
+                        return Err(ScenarioError::at(
+                            cx.path,
+                            None,
+                            ck.prefix.clone(),
+                            "expected exactly one of `coefficient` (N m s/rad) or \
+                             `time_constant` (s)",
+                        ));
+                    }
+                };
+                out.push(Box::new(EnergySink {
+                    name: name_of(&e.name),
+                    coefficient,
+                    inertia: cx.hub.inertia,
+                }));
+            }
+            EffectorSpec::SpringMassDamper(s) => {
+                let model = SpringMass {
+                    mass: ck.positive(&s.mass, "mass", "kg")?,
+                    position: ck.on_body(&s.position, "position", cx.shape)?,
+                    direction: ck.unit(&s.direction, "direction")?,
+                    stiffness: ck.non_negative(&s.stiffness, "stiffness", "N/m")?,
+                    damping: ck.non_negative(&s.damping, "damping", "N s/m")?,
+                };
+                let q0 = ck.finite(&s.initial_offset, "initial_offset", "m")?;
+                let u0 = ck.finite(&s.initial_rate, "initial_rate", "m/s")?;
+                out.push(Box::new(ParticleEffector::new(
+                    name_of(&s.name),
+                    model,
+                    &[q0],
+                    &[u0],
+                )));
+            }
+            EffectorSpec::WheelDamper(w) => {
+                out.push(Box::new(WheelDamper {
+                    name: name_of(&w.name),
+                    inertia: ck.positive(&w.inertia, "inertia", "kg m²")?,
+                    axis: ck.unit(&w.axis, "axis")?,
+                    damping: ck.non_negative(&w.damping, "damping", "N m s/rad")?,
+                    initial_rate: ck.finite(&w.initial_rate, "initial_rate", "rad/s")?,
+                    position: match &w.position {
+                        Some(p) => ck.point(p, "position")?,
+                        None => Vector3::zeros(),
+                    },
+                }));
+                // The rotor is part of the body's inertia: it cannot exceed it about its axis.
+                let a = out.last().map(|_| ck.unit(&w.axis, "axis")).transpose()?;
+                if let Some(a) = a {
+                    let about_axis = a.dot(&(cx.hub.inertia * a));
+                    if w.inertia.value >= about_axis {
+                        return Err(ck.err(
+                            &w.inertia,
+                            "inertia",
+                            format!(
+                                "the rotor's inertia must be less than the body's about the \
+                                 same axis ({about_axis} kg m²), which includes it"
+                            ),
+                        ));
+                    }
+                }
+            }
+            EffectorSpec::HingedRod(h) => {
+                let freedom = match h.freedom.as_ref().map(|f| f.value.as_str()) {
+                    None | Some("flap_lag") => HingeFreedom::FlapLag,
+                    Some("flap") => HingeFreedom::Flap,
+                    Some("lag") => HingeFreedom::Lag,
+                    Some(other) => {
+                        let f = h.freedom.as_ref().expect("present");
+                        return Err(ck.err(
+                            f,
+                            "freedom",
+                            format!("unknown freedom `{other}`, expected flap_lag, flap or lag"),
+                        ));
+                    }
+                };
+                let mass = ck.positive(&h.mass, "mass", "kg")?;
+                let length = ck.positive(&h.length, "length", "m")?;
+                let direction = ck.unit(&h.direction, "direction")?;
+                let axis = ck.perpendicular(&h.axis, "axis", &direction, "direction")?;
+                let hinge = ck.on_body(&h.hinge, "hinge", cx.shape)?;
+                let pair = |s: &Spanned<PerAngle>, key: &str, unit: &str| {
+                    let p = s.value.pair();
+                    if p.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                        Ok(p)
+                    } else {
+                        Err(ck.err(
+                            s,
+                            key,
+                            format!("expected a value ≥ 0 or [flap, lag] values ≥ 0 ({unit})"),
+                        ))
+                    }
+                };
+                let stiffness = pair(&h.stiffness, "stiffness", "N m/rad")?;
+                let damping = pair(&h.damping, "damping", "N m s/rad")?;
+                let finite2 = |s: &Option<Spanned<[f64; 2]>>, key: &str| match s {
+                    None => Ok([0.0; 2]),
+                    Some(v) if v.value.iter().all(|x| x.is_finite()) => Ok(v.value),
+                    Some(v) => Err(ck.err(v, key, "expected [flap, lag], two finite numbers")),
+                };
+                let a0 = finite2(&h.initial_angles, "initial_angles")?;
+                let r0 = finite2(&h.initial_rates, "initial_rates")?;
+                let (q0, u0): (Vec<f64>, Vec<f64>) = match freedom {
+                    HingeFreedom::FlapLag => (a0.to_vec(), r0.to_vec()),
+                    HingeFreedom::Flap => (vec![a0[0]], vec![r0[0]]),
+                    HingeFreedom::Lag => (vec![a0[1]], vec![r0[1]]),
+                };
+                let rotations = ck.copies(&h.copies)?;
+                let count = rotations.len();
+                for (k, rot) in rotations.into_iter().enumerate() {
+                    let rod = HingedRod {
+                        mass,
+                        length,
+                        hinge: rot * hinge,
+                        direction: rot * direction,
+                        axis: rot * axis,
+                        freedom,
+                        stiffness,
+                        damping,
+                    };
+                    let name = copy_name(&name_of(&h.name), k, count);
+                    out.push(Box::new(ParticleEffector::new(name, rod, &q0, &u0)));
+                }
+            }
+            EffectorSpec::ModalAppendage(m) => {
+                let props = BeamProperties {
+                    length: ck.positive(&m.length, "length", "m")?,
+                    bending_stiffness: ck.positive(
+                        &m.bending_stiffness,
+                        "bending_stiffness",
+                        "N m²",
+                    )?,
+                    mass_per_length: ck.positive(&m.mass_per_length, "mass_per_length", "kg/m")?,
+                    tip_mass: match &m.tip_mass {
+                        Some(t) => ck.non_negative(t, "tip_mass", "kg")?,
+                        None => 0.0,
+                    },
+                };
+                let n_modes = match &m.modes {
+                    None => 3,
+                    Some(n) if (1..=10).contains(&n.value) => n.value as usize,
+                    Some(n) => return Err(ck.err(n, "modes", "expected 1 to 10 modes")),
+                };
+                let zeta = match &m.damping_ratio {
+                    None => 0.005,
+                    Some(z) => ck.non_negative(z, "damping_ratio", "–")?,
+                };
+                let direction = ck.unit(&m.direction, "direction")?;
+                let flap =
+                    ck.perpendicular(&m.flap_direction, "flap_direction", &direction, "direction")?;
+                let lag = direction.cross(&flap);
+                let attachment = ck.on_body(&m.attachment, "attachment", cx.shape)?;
+                let which = match m.bending.as_ref().map(|b| b.value.as_str()) {
+                    None | Some("both") => vec![true, true],
+                    Some("flap") => vec![true, false],
+                    Some("lag") => vec![false, true],
+                    Some(other) => {
+                        let b = m.bending.as_ref().expect("present");
+                        return Err(ck.err(
+                            b,
+                            "bending",
+                            format!("unknown bending `{other}`, expected both, flap or lag"),
+                        ));
+                    }
+                };
+                let modes = beam_modes(&props, n_modes).map_err(|e| {
+                    ScenarioError::at(cx.path, loc(&m.length), ck.prefix.clone(), e)
+                })?;
+                let tip0 = match &m.initial_tip_deflection {
+                    None => [0.0; 2],
+                    Some(v) if v.value.iter().all(|x| x.is_finite()) => v.value,
+                    Some(v) => {
+                        return Err(ck.err(
+                            v,
+                            "initial_tip_deflection",
+                            "expected [flap, lag], two finite numbers (m)",
+                        ));
+                    }
+                };
+                let tip_phi = modes.nodes[modes.tip].phi[0];
+                let rotations = ck.copies(&m.copies)?;
+                let count = rotations.len();
+                for (k, rot) in rotations.into_iter().enumerate() {
+                    let mut bending = Vec::new();
+                    let mut q0 = Vec::new();
+                    for (d, (label, t)) in [("flap", flap), ("lag", lag)].into_iter().enumerate() {
+                        if which[d] {
+                            bending.push((label.to_string(), rot * t));
+                            let mut q = vec![0.0; n_modes];
+                            q[0] = tip0[d] / tip_phi;
+                            q0.extend(q);
+                        }
+                    }
+                    let n = q0.len();
+                    let beam = ModalBeam::new(
+                        modes.clone(),
+                        rot * attachment,
+                        rot * direction,
+                        bending,
+                        zeta,
+                        m.geometric_stiffening.unwrap_or(true),
+                    );
+                    let name = copy_name(&name_of(&m.name), k, count);
+                    out.push(Box::new(ParticleEffector::new(name, beam, &q0, &vec![0.0; n])));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn copy_name(base: &str, k: usize, count: usize) -> String {
+    if count > 1 {
+        format!("{base}_{}", k + 1)
+    } else {
+        base.to_string()
+    }
+}
+
+fn check_psd<T>(
+    ck: &Check,
+    s: &Spanned<T>,
+    key: &str,
+    m: &Matrix3<f64>,
+) -> Result<(), ScenarioError> {
+    if !m.iter().all(|x| x.is_finite()) {
+        return Err(ck.err(s, key, "expected finite numbers (N m s/rad)"));
+    }
+    let scale = m.amax().max(f64::MIN_POSITIVE);
+    if (m - m.transpose()).amax() > 1e-12 * scale {
+        return Err(ck.err(s, key, "expected a symmetric matrix"));
+    }
+    let eig = m.symmetric_eigenvalues();
+    if eig.min() < -1e-12 * scale {
+        return Err(ck.err(
+            s,
+            key,
+            format!(
+                "expected a positive semi-definite matrix (a dissipation function cannot be \
+                 negative); its smallest eigenvalue is {:e}",
+                eig.min()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Validates `hub_motion:`.
+pub(super) fn motion(path: &Path, spec: &HubMotionSpec) -> Result<SpinUp, ScenarioError> {
+    let ck = Check {
+        path,
+        prefix: "hub_motion.spin_up".into(),
+    };
+    match spec {
+        HubMotionSpec::SpinUp {
+            axis,
+            rate,
+            ramp_time,
+        } => Ok(SpinUp {
+            axis: ck.unit(axis, "axis")?,
+            rate: ck.finite(&Some(rate.clone()), "rate", "rad/s")?,
+            ramp_time: ck.positive(ramp_time, "ramp_time", "s")?,
+        }),
+    }
+}
