@@ -6,6 +6,7 @@
 
 use crate::linearize::{Linearization, linearize, spin_rate_of};
 use crate::log::McapLogger;
+use crate::model::RigidBody;
 use crate::scenario::{self, Overrides, Scenario};
 use crate::sim::{self, Control, NullSink, Outcome, Status};
 use clap::{Parser, Subcommand};
@@ -192,26 +193,53 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
         lin.principal_moments[2]
     );
     println!(
-        "  {:>16} {:>16}  {:<12} time constant",
-        "Re (1/s)", "Im (rad/s)", "mode"
+        "  {:>16} {:>16}  {:<12} {:<9} time constant",
+        "Re (1/s)", "Im (rad/s)", "mode", "role"
     );
     for m in &lin.modes {
         let tc = m
             .time_constant
             .map(|t| format!("{t:.6} s"))
             .unwrap_or_else(|| "-".into());
-        println!("  {:>16.9e} {:>16.9e}  {:<12} {tc}", m.re, m.im, m.kind);
+        println!(
+            "  {:>16.9e} {:>16.9e}  {:<12} {:<9} {tc}",
+            m.re, m.im, m.kind, m.role
+        );
     }
     println!("  verdict: {}", lin.verdict);
-    if let Some(tc) = lin.time_constant {
+    if let Some(n) = &lin.nutation {
+        let what = if n.rate > 0.0 { "grows" } else { "decays" };
+        match n.time_constant {
+            Some(tc) => println!(
+                "  nutation {what} at {:.9e} 1/s (time constant {tc:.6} s), frequency {:.6e} \
+                 rad/s",
+                n.rate, n.frequency
+            ),
+            None => println!("  nutation: neutral, frequency {:.6e} rad/s", n.frequency),
+        }
+        if let (Some(r), Some(tc)) = (n.energy_sink_rate, n.energy_sink_time_constant) {
+            println!(
+                "  energy-sink estimate: {r:.9e} 1/s (time constant {tc:.6} s), {:+.1}% from \
+                 the eigenvalue",
+                100.0 * (r - n.rate) / n.rate.abs().max(f64::MIN_POSITIVE)
+            );
+        }
+    } else if let Some(tc) = lin.time_constant {
         let what = if lin.max_growth_rate > 0.0 {
             "growth"
         } else {
             "decay"
         };
         println!(
-            "  nutation {what} rate {:.9e} 1/s, time constant {tc:.6} s",
+            "  {what} rate {:.9e} 1/s, time constant {tc:.6} s",
             lin.max_growth_rate
+        );
+    }
+    if lin.equilibrium_residual > 1e-9 {
+        println!(
+            "  warning: the effectors at rest are not in equilibrium under this spin (residual \
+             {:.3e}); the linearisation is about a point that is not steady",
+            lin.equilibrium_residual
         );
     }
     let r = &lin.rigid_body_prediction;
@@ -413,6 +441,10 @@ struct Summary<'a> {
     #[serde(rename = "final")]
     final_state: State,
     drift: &'a sim::Drift,
+    /// Whether H_N is conserved by the model (no external torque, no prescribed motion):
+    /// then `drift.h_*` measure integration error; otherwise they are physical changes.
+    conserves_momentum: bool,
+    effectors: Vec<EffectorInfo>,
     steps: u64,
     rejected_steps: u64,
     rhs_evaluations: u64,
@@ -421,7 +453,16 @@ struct Summary<'a> {
     events: &'a [sim::EventRecord],
 }
 
-/// Mass properties as polhode computed them.
+/// An effector as built from the scenario.
+#[derive(serde::Serialize)]
+struct EffectorInfo {
+    name: String,
+    kind: &'static str,
+    states: Vec<String>,
+}
+
+/// Mass properties as polhode computed them: the whole spacecraft, effectors locked in their
+/// initial configuration, about its centre of mass.
 #[derive(serde::Serialize)]
 struct Body {
     /// Principal moments, ascending (kg m²).
@@ -433,12 +474,20 @@ struct Body {
 }
 
 fn body(s: &Scenario) -> Body {
-    let hub = &s.spacecraft.hub;
+    let sc = &s.spacecraft;
+    let (p, axes) = if sc.effectors().is_empty() {
+        (sc.hub.principal_moments, sc.hub.principal_axes)
+    } else {
+        let y0 = sc.initial_state(&s.omega0, &s.attitude0);
+        match RigidBody::new(sc.system_inertia(&y0)) {
+            Ok(b) => (b.principal_moments, b.principal_axes),
+            Err(_) => (sc.hub.principal_moments, sc.hub.principal_axes),
+        }
+    };
     let axis = |c: usize| {
-        let a = hub.principal_axes.column(c);
+        let a = axes.column(c);
         [a[0], a[1], a[2]]
     };
-    let p = hub.principal_moments;
     let sa = s.spacecraft.spin_axis;
     Body {
         principal_moments: [p[0], p[1], p[2]],
@@ -453,6 +502,8 @@ struct State {
     omega: [f64; 3],
     q: Quat,
     kinetic_energy: f64,
+    elastic_energy: f64,
+    dissipated_energy: f64,
     h_norm: f64,
     h_inertial: [f64; 3],
     nutation_angle_deg: f64,
@@ -477,6 +528,8 @@ fn state(o: &crate::model::Observation) -> State {
             z: o.attitude.k,
         },
         kinetic_energy: o.kinetic_energy,
+        elastic_energy: o.elastic_energy,
+        dissipated_energy: o.dissipated_energy,
         h_norm: o.h_norm,
         h_inertial: [o.h_inertial[0], o.h_inertial[1], o.h_inertial[2]],
         nutation_angle_deg: o.nutation_angle.to_degrees(),
@@ -496,6 +549,17 @@ fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         initial: state(&o.initial_observation),
         final_state: state(&o.final_observation),
         drift: &o.drift,
+        conserves_momentum: s.spacecraft.conserves_momentum(),
+        effectors: s
+            .spacecraft
+            .effectors()
+            .iter()
+            .map(|e| EffectorInfo {
+                name: e.name().to_string(),
+                kind: e.kind(),
+                states: e.state_names(),
+            })
+            .collect(),
         steps: o.stats.steps,
         rejected_steps: o.stats.rejected_steps,
         rhs_evaluations: o.stats.rhs_evaluations,
@@ -548,10 +612,32 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
         f.h_norm,
         f.nutation_angle.to_degrees()
     );
-    println!(
-        "  drift: |H| {:.3e}  H_N {:.3e}  T {:.3e}  |q| {:.3e}",
-        o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.kinetic_energy_rel, o.drift.q_norm
-    );
+    if !s.spacecraft.effectors().is_empty() {
+        println!(
+            "  elastic {:.6e} J   dissipated {:.6e} J   ({} effectors, {} states)",
+            f.elastic_energy,
+            f.dissipated_energy,
+            s.spacecraft.effectors().len(),
+            crate::integrate::OdeSystem::dim(&s.spacecraft)
+        );
+    }
+    let (label, energy) = if s.spacecraft.effectors().is_empty() {
+        ("T", "drift")
+    } else {
+        ("T+V+W", "drift")
+    };
+    if s.spacecraft.conserves_momentum() {
+        println!(
+            "  {energy}: |H| {:.3e}  H_N {:.3e}  {label} {:.3e}  |q| {:.3e}",
+            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
+        );
+    } else {
+        println!(
+            "  change (external torque or prescribed motion): |H| {:.3e}  H_N {:.3e}; \
+             {energy}: {label} {:.3e}  |q| {:.3e}",
+            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
+        );
+    }
     println!(
         "  work: {} steps ({} rejected), {} RHS evaluations, {} samples, {:.3} s wall",
         o.stats.steps, o.stats.rejected_steps, o.stats.rhs_evaluations, o.samples, o.wall_time

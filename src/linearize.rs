@@ -115,9 +115,11 @@ fn principal(i: &Matrix3<f64>) -> ([f64; 3], Matrix3<f64>) {
 /// Linearises `sc` about steady spin at `spin_rate` (rad/s) about its spin axis.
 pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, String> {
     if sc.motion().is_some() {
-        return Err("the hub's rotation is prescribed (`hub_motion`), so there is no free \
+        return Err(
+            "the hub's rotation is prescribed (`hub_motion`), so there is no free \
                     steady spin to linearise about"
-            .into());
+                .into(),
+        );
     }
     let s = sc.spin_axis;
     let rest = sc.rest_state(&Vector3::zeros(), &UnitQuaternion::identity());
@@ -163,9 +165,9 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     for (k, e) in sc.effectors().iter().enumerate() {
         let off = sc.effector_offset(k);
         let state_names = e.state_names();
-        for j in 0..e.num_dynamic_states() {
+        for (j, state) in state_names.iter().enumerate().take(e.num_dynamic_states()) {
             idx.push(off + j);
-            names.push(format!("{}.{}", e.name(), state_names[j]));
+            names.push(format!("{}.{state}", e.name()));
         }
     }
     let scale = spin_rate.abs();
@@ -173,13 +175,23 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     sc.rhs(0.0, &y_eq, &mut f0);
     let equilibrium_residual = idx
         .iter()
-        .map(|&i| if i < 3 { f0[i].abs() / (scale * scale) } else { f0[i].abs() })
+        .map(|&i| {
+            if i < 3 {
+                f0[i].abs() / (scale * scale)
+            } else {
+                f0[i].abs()
+            }
+        })
         .fold(0.0, f64::max);
     let m = idx.len();
     let mut jac = DMatrix::<f64>::zeros(m, m);
     let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
     for (col, &j) in idx.iter().enumerate() {
-        let h = if j < HUB_STATES { 1e-6 * scale.max(1e-3) } else { 1e-6 };
+        let h = if j < HUB_STATES {
+            1e-6 * scale.max(1e-3)
+        } else {
+            1e-6
+        };
         let mut yp = y_eq.clone();
         let mut ym = y_eq.clone();
         yp[j] += h;
@@ -296,9 +308,7 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             frequency: v.im.abs(),
             time_constant: (v.re.abs() > zero).then(|| 1.0 / v.re.abs()),
             energy_sink_rate: estimate,
-            energy_sink_time_constant: estimate
-                .filter(|r| r.abs() > 0.0)
-                .map(|r| 1.0 / r.abs()),
+            energy_sink_time_constant: estimate.filter(|r| r.abs() > 0.0).map(|r| 1.0 / r.abs()),
         }
     });
 
@@ -343,7 +353,8 @@ fn energy_sink_estimate(
     let inv = inertia.try_inverse()?;
     let a = inv * (cross(&(inertia * omega_eq)) - cross(&omega_eq) * inertia);
     let lambda = C64::new(0.0, nu);
-    let shifted = a.map(|x| C64::new(x, 0.0)) - Matrix3::identity().map(|x| C64::new(x, 0.0)) * lambda;
+    let shifted =
+        a.map(|x| C64::new(x, 0.0)) - Matrix3::identity().map(|x| C64::new(x, 0.0)) * lambda;
     // Null vector of the rank-2 matrix: the cross product of two independent rows.
     let rows: Vec<[C64; 3]> = (0..3)
         .map(|r| [shifted[(r, 0)], shifted[(r, 1)], shifted[(r, 2)]])
@@ -419,7 +430,12 @@ fn energy_sink_estimate(
     for (r, &i) in x_idx.iter().enumerate() {
         for (c, &j) in x_idx.iter().enumerate().skip(r) {
             let mut val = 0.0;
-            for (si, sj, sign) in [(1.0, 1.0, 1.0), (1.0, -1.0, -1.0), (-1.0, 1.0, -1.0), (-1.0, -1.0, 1.0)] {
+            for (si, sj, sign) in [
+                (1.0, 1.0, 1.0),
+                (1.0, -1.0, -1.0),
+                (-1.0, 1.0, -1.0),
+                (-1.0, -1.0, 1.0),
+            ] {
                 let mut y = y_eq.to_vec();
                 y[i] += si * hp;
                 y[j] += sj * hp;
@@ -434,15 +450,19 @@ fn energy_sink_estimate(
     }
     // ⟨P⟩ = ¼ Re(Xᴴ D X) for x(t) = Re(X e^{iνt}).
     let dx = d.map(|x| C64::new(x, 0.0)) * &x;
-    let mean_power = 0.25 * x.iter().zip(dx.iter()).map(|(a, b)| (a.conj() * b).re).sum::<f64>();
+    let mean_power = 0.25
+        * x.iter()
+            .zip(dx.iter())
+            .map(|(a, b)| (a.conj() * b).re)
+            .sum::<f64>();
     // ⟨ΔE⟩ = ½ Σ I_i (1 − I_i/I_s) ⟨δω_i²⟩, ⟨δω_i²⟩ = ½|v_i|², in principal axes.
     let (moments, axes) = principal(inertia);
     let i_s = spin_axis.dot(&(inertia * spin_axis));
     let mut mean_excess = 0.0;
-    for k in 0..3 {
+    for (k, moment) in moments.iter().enumerate() {
         let col = axes.column(k);
         let vk: C64 = (0..3).map(|r| v[r] * col[r]).sum();
-        mean_excess += 0.5 * moments[k] * (1.0 - moments[k] / i_s) * 0.5 * vk.norm_sqr();
+        mean_excess += 0.5 * moment * (1.0 - moment / i_s) * 0.5 * vk.norm_sqr();
     }
     if mean_excess == 0.0 {
         return None;

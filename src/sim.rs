@@ -63,8 +63,9 @@ pub struct Drift {
     pub h_norm_rel: f64,
     /// max |H_N − H_N₀| / |H₀| (the inertial momentum vector).
     pub h_inertial_rel: f64,
-    /// max |(T − T₀)| / T₀.
-    pub kinetic_energy_rel: f64,
+    /// max |E − E₀| / E₀ for the energy balance E = kinetic + elastic + dissipated (just T
+    /// for a rigid body).
+    pub energy_rel: f64,
     /// max ||q| − 1|.
     pub q_norm: f64,
 }
@@ -74,7 +75,7 @@ pub struct Drift {
 pub struct Reference {
     h0: f64,
     h_inertial0: Vector3<f64>,
-    t0: f64,
+    e0: f64,
 }
 
 impl Reference {
@@ -83,7 +84,7 @@ impl Reference {
         Reference {
             h0: o.h_norm,
             h_inertial0: o.h_inertial,
-            t0: o.kinetic_energy,
+            e0: o.energy_balance(),
         }
     }
 
@@ -92,16 +93,16 @@ impl Reference {
         rel(o.h_norm - self.h0, self.h0)
     }
 
-    /// Signed relative change of T at `o`.
-    pub fn t_rel(&self, o: &Observation) -> f64 {
-        rel(o.kinetic_energy - self.t0, self.t0)
+    /// Signed relative change of the energy balance (kinetic + elastic + dissipated) at `o`.
+    pub fn energy_rel(&self, o: &Observation) -> f64 {
+        rel(o.energy_balance() - self.e0, self.e0)
     }
 
     fn update(&self, d: &mut Drift, i: &Invariants) {
         let h = rel(i.h_body.norm() - self.h0, self.h0);
         d.h_norm_rel = d.h_norm_rel.max(h.abs());
-        let t = rel(i.kinetic_energy - self.t0, self.t0);
-        d.kinetic_energy_rel = d.kinetic_energy_rel.max(t.abs());
+        let e = rel(i.energy_balance() - self.e0, self.e0);
+        d.energy_rel = d.energy_rel.max(e.abs());
         d.h_inertial_rel = d
             .h_inertial_rel
             .max(rel((i.h_inertial - self.h_inertial0).norm(), self.h0));

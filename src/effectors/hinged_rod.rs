@@ -90,6 +90,11 @@ const STATIONS: [f64; 2] = [
 ];
 
 impl ParticleModel for HingedRod {
+    /// ê, ∂ê/∂θ_f, ∂ê/∂θ_l and the convective Σ ∂²ê u u at the current angles and rates.
+    type Cache = [Vector3<f64>; 4];
+    fn prepare(&self, q: &[f64], u: &[f64]) -> Self::Cache {
+        self.direction_at(self.angles(q, u))
+    }
     fn kind(&self) -> &'static str {
         "hinged_rod"
     }
@@ -109,9 +114,16 @@ impl ParticleModel for HingedRod {
     fn num_particles(&self) -> usize {
         2
     }
-    fn particle(&self, p: usize, q: &[f64], u: &[f64], out: &mut ParticlePoint) {
+    fn particle(
+        &self,
+        p: usize,
+        cache: &Self::Cache,
+        _q: &[f64],
+        _u: &[f64],
+        out: &mut ParticlePoint,
+    ) {
         let s = STATIONS[p] * self.length;
-        let [e, e_f, e_l, kappa] = self.direction_at(self.angles(q, u));
+        let [e, e_f, e_l, kappa] = *cache;
         out.mass = 0.5 * self.mass;
         out.position = self.hinge + s * e;
         match self.freedom {

@@ -106,6 +106,7 @@ fn quadratic(s: &[f64], a: &[f64], b: &[f64], n: usize) -> f64 {
 }
 
 impl ParticleModel for ModalBeam {
+    type Cache = ();
     fn kind(&self) -> &'static str {
         "modal_appendage"
     }
@@ -122,7 +123,7 @@ impl ParticleModel for ModalBeam {
     fn num_particles(&self) -> usize {
         self.massive.len()
     }
-    fn particle(&self, p: usize, q: &[f64], u: &[f64], out: &mut ParticlePoint) {
+    fn particle(&self, p: usize, _c: &(), q: &[f64], u: &[f64], out: &mut ParticlePoint) {
         let n = self.n_modes();
         let node = &self.modes.nodes[self.massive[p]];
         out.mass = node.mass;

@@ -58,6 +58,12 @@ impl Default for ParticlePoint {
 
 /// A set of particles moved by `n` coordinates, with springs and dashpots on them.
 pub trait ParticleModel: Debug + Send + Sync {
+    /// What is shared by all particles at given coordinates and rates (computed once).
+    type Cache: Default;
+    /// Computes the shared part of the kinematics at coordinates `q` and rates `u`.
+    fn prepare(&self, _q: &[f64], _u: &[f64]) -> Self::Cache {
+        Self::Cache::default()
+    }
     /// The YAML kind.
     fn kind(&self) -> &'static str;
     /// Number of coordinates n (≤ [`MAX_COORDINATES`]).
@@ -66,8 +72,16 @@ pub trait ParticleModel: Debug + Send + Sync {
     fn coordinate_names(&self) -> Vec<String>;
     /// Number of particles.
     fn num_particles(&self) -> usize;
-    /// Fills `out` with particle `p`'s kinematics at coordinates `q` and rates `u`.
-    fn particle(&self, p: usize, q: &[f64], u: &[f64], out: &mut ParticlePoint);
+    /// Fills `out` with particle `p`'s kinematics at coordinates `q` and rates `u` (`cache`
+    /// from [`ParticleModel::prepare`] at the same `q` and `u`).
+    fn particle(
+        &self,
+        p: usize,
+        cache: &Self::Cache,
+        q: &[f64],
+        u: &[f64],
+        out: &mut ParticlePoint,
+    );
     /// Generalised forces of springs and dashpots, written into `out` (length n).
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]);
     /// Elastic energy (J).
@@ -120,47 +134,56 @@ fn cross_matrix(r: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
 }
 
-/// In-place Cholesky of the n × n leading block of `a` (row stride `MAX_COORDINATES`);
-/// returns false if not positive definite.
+/// In-place Cholesky of the n × n row-major `a` (lower triangle read and written); returns
+/// false if not positive definite.
 fn cholesky(a: &mut [f64], n: usize) -> bool {
-    const S: usize = MAX_COORDINATES;
     for j in 0..n {
-        let mut d = a[j * S + j];
+        let mut d = a[j * n + j];
         for k in 0..j {
-            d -= a[j * S + k] * a[j * S + k];
+            d -= a[j * n + k] * a[j * n + k];
         }
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return false;
         }
         let d = d.sqrt();
-        a[j * S + j] = d;
+        a[j * n + j] = d;
         for i in j + 1..n {
-            let mut s = a[i * S + j];
+            let mut s = a[i * n + j];
             for k in 0..j {
-                s -= a[i * S + k] * a[j * S + k];
+                s -= a[i * n + k] * a[j * n + k];
             }
-            a[i * S + j] = s / d;
+            a[i * n + j] = s / d;
         }
     }
     true
 }
 
-/// Solves L Lᵀ x = b in place (`l` from [`cholesky`]).
-fn cholesky_solve(l: &[f64], n: usize, b: &mut [f64]) {
-    const S: usize = MAX_COORDINATES;
+/// Solves L Lᵀ X = B in place for `m` right-hand sides (`b` row-major n × m; `l` from
+/// [`cholesky`]).
+fn cholesky_solve_many(l: &[f64], n: usize, b: &mut [f64], m: usize) {
     for i in 0..n {
-        let mut s = b[i];
         for k in 0..i {
-            s -= l[i * S + k] * b[k];
+            let lik = l[i * n + k];
+            for c in 0..m {
+                b[i * m + c] -= lik * b[k * m + c];
+            }
         }
-        b[i] = s / l[i * S + i];
+        let d = l[i * n + i];
+        for c in 0..m {
+            b[i * m + c] /= d;
+        }
     }
     for i in (0..n).rev() {
-        let mut s = b[i];
         for k in i + 1..n {
-            s -= l[k * S + i] * b[k];
+            let lki = l[k * n + i];
+            for c in 0..m {
+                b[i * m + c] -= lki * b[k * m + c];
+            }
         }
-        b[i] = s / l[i * S + i];
+        let d = l[i * n + i];
+        for c in 0..m {
+            b[i * m + c] /= d;
+        }
     }
 }
 
@@ -191,24 +214,29 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
         true
     }
     fn scratch_len(&self) -> usize {
-        7 * self.model.num_coordinates()
+        // y_g (n), Y (6n); workspace: M (n²), Cᵀ (6n), g (n).
+        let n = self.model.num_coordinates();
+        14 * n + n * n
     }
 
     fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        const S: usize = MAX_COORDINATES;
         let n = self.model.num_coordinates();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let w = hub.omega;
-        let mut mass = [0.0; S * S];
-        // Cᵀ (n × 6), row-major with stride 6; g (n).
-        let mut ct = [0.0; S * 6];
-        let mut g = [0.0; S];
+        let (kept, work) = scratch.split_at_mut(7 * n);
+        let (mass, work) = work.split_at_mut(n * n);
+        let (ct, g) = work.split_at_mut(6 * n);
+        // M (n × n, row-major), Cᵀ (n × 6, row-major), g (n).
+        mass.fill(0.0);
+        ct.fill(0.0);
+        g.fill(0.0);
         let mut d_rr = Matrix3::zeros();
         let (mut m_sum, mut s_sum) = (0.0, Vector3::zeros());
         let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
         let mut pt = ParticlePoint::default();
+        let cache = self.model.prepare(q, u);
         for p in 0..self.model.num_particles() {
-            self.model.particle(p, q, u, &mut pt);
+            self.model.particle(p, &cache, q, u, &mut pt);
             let m = pt.mass;
             let r = pt.position;
             let jac = &pt.jacobian[..n];
@@ -220,7 +248,7 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             for k in 0..n {
                 let jk = jac[k];
                 for l in 0..=k {
-                    mass[k * S + l] += m * jk.dot(&jac[l]);
+                    mass[k * n + l] += m * jk.dot(&jac[l]);
                 }
                 let rj = r.cross(&jk);
                 let row = &mut ct[k * 6..k * 6 + 6];
@@ -238,13 +266,10 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             e_t += m * c;
             e_r += m * r.cross(&c);
         }
-        let mut forces = [0.0; S];
+        let mut forces = [0.0; MAX_COORDINATES];
         self.model.forces(q, u, &mut forces[..n]);
         for k in 0..n {
             g[k] += forces[k];
-            for l in 0..k {
-                mass[l * S + k] = mass[k * S + l];
-            }
         }
         // D and e.
         let sx = cross_matrix(&s_sum);
@@ -262,35 +287,29 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             coupling.force[3 + i] -= e_r[i];
         }
         coupling.translation = true;
-        if !cholesky(&mut mass, n) {
+        if !cholesky(mass, n) {
             // A degenerate configuration: poison the hub solve, so the run stops with a
             // diagnosis rather than continuing with nonsense.
             coupling.force[0] = f64::NAN;
-            scratch.fill(f64::NAN);
+            kept.fill(f64::NAN);
             return;
         }
-        // Y = M⁻¹ Cᵀ (n × 6) and y_g = M⁻¹ g, kept for `derivatives`.
-        let (yg, y) = scratch.split_at_mut(n);
-        yg.copy_from_slice(&g[..n]);
-        cholesky_solve(&mass, n, yg);
-        let mut col = [0.0; S];
-        for c6 in 0..6 {
-            for k in 0..n {
-                col[k] = ct[k * 6 + c6];
-            }
-            cholesky_solve(&mass, n, &mut col[..n]);
-            for k in 0..n {
-                y[k * 6 + c6] = col[k];
-            }
+        // Y = M⁻¹ Cᵀ (n × 6) and y_g = M⁻¹ g, kept for `derivatives`: one solve with 7
+        // right-hand sides, [g | Cᵀ] row-major with stride 7.
+        let rhs = &mut kept[..7 * n];
+        for k in 0..n {
+            rhs[k * 7] = g[k];
+            rhs[k * 7 + 1..k * 7 + 7].copy_from_slice(&ct[k * 6..k * 6 + 6]);
         }
+        cholesky_solve_many(mass, n, rhs, 7);
         // mass −= C Y ; force −= C y_g, with C = (Cᵀ)ᵀ.
         for k in 0..n {
             let ck = &ct[k * 6..k * 6 + 6];
-            let yk = &y[k * 6..k * 6 + 6];
-            for a in 0..6 {
-                coupling.force[a] -= ck[a] * yg[k];
+            let yk = &rhs[k * 7..k * 7 + 7];
+            for (a, &cka) in ck.iter().enumerate() {
+                coupling.force[a] -= cka * yk[0];
                 for b in 0..6 {
-                    coupling.mass[(a, b)] -= ck[a] * yk[b];
+                    coupling.mass[(a, b)] -= cka * yk[1 + b];
                 }
             }
         }
@@ -307,13 +326,12 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
         let n = self.model.num_coordinates();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let z = accel.as_vector6();
-        let (yg, y) = scratch.split_at(n);
         dx[..n].copy_from_slice(u);
         for k in 0..n {
-            let yk = &y[k * 6..k * 6 + 6];
-            let mut s = yg[k];
+            let yk = &scratch[k * 7..k * 7 + 7];
+            let mut s = yk[0];
             for a in 0..6 {
-                s -= yk[a] * z[a];
+                s -= yk[1 + a] * z[a];
             }
             dx[n + k] = s;
         }
@@ -326,8 +344,9 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let mut out = Momentum::default();
         let mut pt = ParticlePoint::default();
+        let cache = self.model.prepare(q, u);
         for p in 0..self.model.num_particles() {
-            self.model.particle(p, q, u, &mut pt);
+            self.model.particle(p, &cache, q, u, &mut pt);
             let m = pt.mass;
             let r = pt.position;
             let mut v = hub.omega.cross(&r);
@@ -384,23 +403,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn cholesky_solves_a_small_system() {
-        const S: usize = MAX_COORDINATES;
-        let mut a = [0.0; S * S];
+    fn cholesky_solves_a_small_system_with_several_right_hand_sides() {
         let m = [[4.0, 2.0, 0.6], [2.0, 5.0, 1.0], [0.6, 1.0, 3.0]];
-        for i in 0..3 {
-            for j in 0..3 {
-                a[i * S + j] = m[i][j];
+        let mut a: Vec<f64> = m.concat();
+        assert!(cholesky(&mut a, 3));
+        // Two right-hand sides, row-major 3 × 2.
+        let rhs = [[1.0, 0.3], [-2.0, 0.0], [0.5, -1.0]];
+        let mut b: Vec<f64> = rhs.concat();
+        cholesky_solve_many(&a, 3, &mut b, 2);
+        for c in 0..2 {
+            for (i, row) in m.iter().enumerate() {
+                let r: f64 = (0..3).map(|k| row[k] * b[k * 2 + c]).sum();
+                assert!((r - rhs[i][c]).abs() < 1e-14);
             }
         }
-        assert!(cholesky(&mut a, 3));
-        let mut b = [1.0, -2.0, 0.5];
-        cholesky_solve(&a, 3, &mut b);
-        for (i, row) in m.iter().enumerate() {
-            let r: f64 = row.iter().zip(&b).map(|(x, y)| x * y).sum();
-            assert!((r - [1.0, -2.0, 0.5][i]).abs() < 1e-14);
-        }
-        let mut singular = [0.0; S * S];
+        let mut singular = vec![0.0; 4];
         assert!(!cholesky(&mut singular, 2));
     }
 }

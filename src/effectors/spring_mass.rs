@@ -25,6 +25,7 @@ pub struct SpringMass {
 }
 
 impl ParticleModel for SpringMass {
+    type Cache = ();
     fn kind(&self) -> &'static str {
         "spring_mass_damper"
     }
@@ -37,7 +38,7 @@ impl ParticleModel for SpringMass {
     fn num_particles(&self) -> usize {
         1
     }
-    fn particle(&self, _p: usize, q: &[f64], _u: &[f64], out: &mut ParticlePoint) {
+    fn particle(&self, _p: usize, _c: &(), q: &[f64], _u: &[f64], out: &mut ParticlePoint) {
         out.mass = self.mass;
         out.position = self.position + q[0] * self.direction;
         out.jacobian[0] = self.direction;

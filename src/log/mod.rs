@@ -8,7 +8,7 @@
 
 pub mod telemetry;
 
-use crate::model::Observation;
+use crate::model::{Drawing, HubState, Observation, Spacecraft};
 use crate::scenario::{Compression, Scenario, Shape, format_epoch};
 use crate::sim::{EventRecord, Outcome, Reference, Sink};
 use foxglove::Encode;
@@ -27,7 +27,10 @@ pub const WORLD_FRAME: &str = "world";
 pub const BODY_FRAME: &str = "body";
 
 /// Writes one run to an MCAP file.
-pub struct McapLogger {
+pub struct McapLogger<'a> {
+    spacecraft: &'a Spacecraft,
+    /// `/effectors/<name>` channel of each effector, in order.
+    effector_channels: Vec<u16>,
     writer: mcap::Writer<BufWriter<File>>,
     temp: TempFile,
     final_path: PathBuf,
@@ -94,10 +97,22 @@ fn add<T: Encode>(w: &mut mcap::Writer<BufWriter<File>>, topic: &str) -> io::Res
         .map_err(io_err)
 }
 
-impl McapLogger {
+/// The protobuf message name for an effector's telemetry: its name made an identifier.
+fn message_name(effector: &str) -> String {
+    let mut m: String = effector
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    if !m.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        m.insert(0, 'E');
+    }
+    m
+}
+
+impl<'a> McapLogger<'a> {
     /// Creates the temporary file next to `path` and writes the header, schemas and
     /// channels. Fails before any integration if the location is not writable.
-    pub fn create(path: &Path, scenario: &Scenario, outcome_ref_omega: f64) -> io::Result<Self> {
+    pub fn create(path: &Path, scenario: &'a Scenario, outcome_ref_omega: f64) -> io::Result<Self> {
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -141,6 +156,26 @@ impl McapLogger {
                 .add_channel(tid, "/telemetry", "protobuf", &BTreeMap::new())
                 .map_err(io_err)?;
             let log = add::<fg::Log>(&mut writer, "/log")?;
+            let mut effector_channels = Vec::new();
+            for e in scenario.spacecraft.effectors() {
+                let mut names = vec!["sim_time".to_string()];
+                names.extend(e.telemetry_names());
+                let message = message_name(e.name());
+                let schema = telemetry::schema_for("polhode.effectors", &message, &names);
+                let id = writer
+                    .add_schema(&format!("polhode.effectors.{message}"), "protobuf", &schema)
+                    .map_err(io_err)?;
+                effector_channels.push(
+                    writer
+                        .add_channel(
+                            id,
+                            &format!("/effectors/{}", e.name()),
+                            "protobuf",
+                            &BTreeMap::from([("kind".to_string(), e.kind().to_string())]),
+                        )
+                        .map_err(io_err)?,
+                );
+            }
             Ok::<_, io::Error>((
                 writer,
                 Channels {
@@ -149,15 +184,18 @@ impl McapLogger {
                     telemetry,
                     log,
                 },
+                effector_channels,
             ))
         })();
-        let (writer, channels) = result?;
+        let (writer, channels, effector_channels) = result?;
         let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
         let size = match &scenario.shape {
             Shape::Box { size, .. } => size.max(),
             Shape::Cylinder { radius, length, .. } => length.max(2.0 * radius),
         };
         Ok(McapLogger {
+            spacecraft: &scenario.spacecraft,
+            effector_channels,
             writer,
             temp,
             final_path: path.to_path_buf(),
@@ -310,7 +348,7 @@ impl McapLogger {
         drop(self);
     }
 
-    fn scene_update(&self, o: &Observation) -> fg::SceneUpdate {
+    fn scene_update(&self, o: &Observation, y: &[f64]) -> fg::SceneUpdate {
         let color = |r, g, b, a| Some(fg::Color { r, g, b, a });
         let quat = |q: &UnitQuaternion<f64>| {
             Some(fg::Quaternion {
@@ -388,6 +426,82 @@ impl McapLogger {
                 }],
             ),
         };
+        let point = |v: &Vector3<f64>| fg::Point3 {
+            x: v[0],
+            y: v[1],
+            z: v[2],
+        };
+        let mut lines = Vec::new();
+        let mut spheres = Vec::new();
+        let mut cylinders = cylinders;
+        let effector_color = color(0.85, 0.2, 0.25, 1.0);
+        for (k, e) in self.spacecraft.effectors().iter().enumerate() {
+            for d in e.drawings(self.spacecraft.effector_states(k, y)) {
+                match d {
+                    Drawing::Line { points, thickness } => lines.push(fg::LinePrimitive {
+                        r#type: fg::line_primitive::Type::LineStrip as i32,
+                        pose: Some(fg::Pose {
+                            position: origin,
+                            orientation: quat(&UnitQuaternion::identity()),
+                        }),
+                        thickness,
+                        scale_invariant: false,
+                        points: points.iter().map(point).collect(),
+                        color: effector_color,
+                        colors: vec![],
+                        indices: vec![],
+                    }),
+                    Drawing::Sphere { center, diameter } => spheres.push(fg::SpherePrimitive {
+                        pose: Some(fg::Pose {
+                            position: Some(fg::Vector3 {
+                                x: center[0],
+                                y: center[1],
+                                z: center[2],
+                            }),
+                            orientation: quat(&UnitQuaternion::identity()),
+                        }),
+                        size: Some(fg::Vector3 {
+                            x: diameter,
+                            y: diameter,
+                            z: diameter,
+                        }),
+                        color: effector_color,
+                    }),
+                    Drawing::Disc {
+                        center,
+                        axis,
+                        diameter,
+                        thickness,
+                    } => {
+                        let orientation = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
+                            .unwrap_or_else(|| {
+                                UnitQuaternion::from_axis_angle(
+                                    &Vector3::x_axis(),
+                                    std::f64::consts::PI,
+                                )
+                            });
+                        cylinders.push(fg::CylinderPrimitive {
+                            pose: Some(fg::Pose {
+                                position: Some(fg::Vector3 {
+                                    x: center[0],
+                                    y: center[1],
+                                    z: center[2],
+                                }),
+                                orientation: quat(&orientation),
+                            }),
+                            size: Some(fg::Vector3 {
+                                x: diameter,
+                                y: diameter,
+                                z: thickness,
+                            }),
+                            bottom_scale: 1.0,
+                            top_scale: 1.0,
+                            color: effector_color,
+                        })
+                    }
+                }
+            }
+        }
         fg::SceneUpdate {
             deletions: vec![],
             entities: vec![fg::SceneEntity {
@@ -402,9 +516,9 @@ impl McapLogger {
                     arrow(&o.h_body, self.scene.h_ref, (0.2, 0.5, 1.0)),
                 ],
                 cubes,
-                spheres: vec![],
+                spheres,
                 cylinders,
-                lines: vec![],
+                lines,
                 triangles: vec![],
                 texts: vec![],
                 models: vec![],
@@ -413,8 +527,8 @@ impl McapLogger {
     }
 }
 
-impl Sink for McapLogger {
-    fn sample(&mut self, o: &Observation, _y: &[f64], inv: &Reference) -> io::Result<()> {
+impl Sink for McapLogger<'_> {
+    fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> io::Result<()> {
         let q = o.attitude;
         let tf = fg::FrameTransforms {
             transforms: vec![fg::FrameTransform {
@@ -441,13 +555,28 @@ impl Sink for McapLogger {
             .last
             .is_none_or(|last| o.t - last >= self.scene.interval * (1.0 - 1e-9));
         if due {
-            let scene = self.scene_update(o);
+            let scene = self.scene_update(o, y);
             self.write(self.channels.scene, o.t, &scene)?;
             self.scene.last = Some(o.t);
         }
         let values = telemetry::values(o, inv);
         telemetry::encode_doubles(&values, &mut self.buf);
-        self.write_raw(self.channels.telemetry, self.log_time(o.t))
+        self.write_raw(self.channels.telemetry, self.log_time(o.t))?;
+        if !self.effector_channels.is_empty() {
+            let hub = HubState {
+                t: o.t,
+                omega: o.omega,
+                attitude: &y[3..7],
+            };
+            for k in 0..self.effector_channels.len() {
+                let e = &self.spacecraft.effectors()[k];
+                let mut values = vec![o.t];
+                values.extend(e.telemetry(&hub, self.spacecraft.effector_states(k, y)));
+                telemetry::encode_doubles(&values, &mut self.buf);
+                self.write_raw(self.effector_channels[k], self.log_time(o.t))?;
+            }
+        }
+        Ok(())
     }
 
     fn event(&mut self, e: &EventRecord, o: &Observation) -> io::Result<()> {

@@ -16,7 +16,7 @@ use prost_types::{
 pub const SCHEMA_NAME: &str = "polhode.Telemetry";
 
 /// Field names in field-number order (field `i` has number `i + 1`); units in `docs/logs.md`.
-pub const FIELDS: [&str; 23] = [
+pub const FIELDS: [&str; 26] = [
     "sim_time",
     "omega_x",
     "omega_y",
@@ -38,30 +38,40 @@ pub const FIELDS: [&str; 23] = [
     "angle_to_principal_2_deg",
     "angle_to_principal_3_deg",
     "drift_h_rel",
-    "drift_t_rel",
+    "drift_energy_rel",
     "q_norm_error",
+    "elastic_energy",
+    "dissipated_energy",
+    "dissipation_power",
 ];
 
 /// The serialized `FileDescriptorSet` describing [`FIELDS`] as proto3 doubles.
 pub fn schema_bytes() -> Vec<u8> {
-    let fields = FIELDS
+    schema_for("polhode", "Telemetry", &FIELDS)
+}
+
+/// A `FileDescriptorSet` for message `package.message` whose fields are the doubles `names`
+/// (numbered from 1 in order).
+pub fn schema_for<S: AsRef<str>>(package: &str, message: &str, names: &[S]) -> Vec<u8> {
+    let fields = names
         .iter()
+        .map(|n| n.as_ref())
         .enumerate()
         .map(|(i, name)| FieldDescriptorProto {
-            name: Some((*name).to_string()),
+            name: Some(name.to_string()),
             number: Some(i as i32 + 1),
             label: Some(Label::Optional as i32),
             r#type: Some(Type::Double as i32),
-            json_name: Some((*name).to_string()),
+            json_name: Some(name.to_string()),
             ..Default::default()
         })
         .collect();
     let file = FileDescriptorProto {
-        name: Some("polhode/Telemetry.proto".into()),
-        package: Some("polhode".into()),
+        name: Some(format!("{}/{message}.proto", package.replace('.', "/"))),
+        package: Some(package.into()),
         syntax: Some("proto3".into()),
         message_type: vec![DescriptorProto {
-            name: Some("Telemetry".into()),
+            name: Some(message.into()),
             field: fields,
             ..Default::default()
         }],
@@ -71,7 +81,7 @@ pub fn schema_bytes() -> Vec<u8> {
 }
 
 /// The values of [`FIELDS`] for one observation.
-pub fn values(o: &Observation, inv: &Reference) -> [f64; 23] {
+pub fn values(o: &Observation, inv: &Reference) -> [f64; 26] {
     let q = o.attitude.quaternion();
     let a = o.angles_to_principal.map(f64::to_degrees);
     [
@@ -96,8 +106,11 @@ pub fn values(o: &Observation, inv: &Reference) -> [f64; 23] {
         a[1],
         a[2],
         inv.h_rel(o),
-        inv.t_rel(o),
+        inv.energy_rel(o),
         o.q_norm_error,
+        o.elastic_energy,
+        o.dissipated_energy,
+        o.dissipation_power,
     ]
 }
 

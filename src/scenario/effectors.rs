@@ -6,8 +6,8 @@
 use super::{ScenarioError, Shape, loc};
 use crate::effectors::beam::{BeamProperties, beam_modes};
 use crate::effectors::{
-    EnergySink, HingeFreedom, HingedRod, ModalBeam, ParticleEffector, Rayleigh, SpinUp,
-    SpringMass, WheelDamper,
+    EnergySink, HingeFreedom, HingedRod, ModalBeam, ParticleEffector, Rayleigh, SpinUp, SpringMass,
+    WheelDamper,
 };
 use crate::model::{Effector, RigidBody};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -247,23 +247,31 @@ impl Check<'_> {
         if v.is_finite() && v > 0.0 {
             Ok(v)
         } else {
-            Err(self.err(s, key, format!("expected a positive, finite value ({unit}), got {v}")))
+            Err(self.err(
+                s,
+                key,
+                format!("expected a positive, finite value ({unit}), got {v}"),
+            ))
         }
     }
-    fn non_negative(
-        &self,
-        s: &Spanned<f64>,
-        key: &str,
-        unit: &str,
-    ) -> Result<f64, ScenarioError> {
+    fn non_negative(&self, s: &Spanned<f64>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
         let v = s.value;
         if v.is_finite() && v >= 0.0 {
             Ok(v)
         } else {
-            Err(self.err(s, key, format!("expected a finite value ≥ 0 ({unit}), got {v}")))
+            Err(self.err(
+                s,
+                key,
+                format!("expected a finite value ≥ 0 ({unit}), got {v}"),
+            ))
         }
     }
-    fn finite(&self, s: &Option<Spanned<f64>>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
+    fn finite(
+        &self,
+        s: &Option<Spanned<f64>>,
+        key: &str,
+        unit: &str,
+    ) -> Result<f64, ScenarioError> {
         match s {
             None => Ok(0.0),
             Some(x) if x.value.is_finite() => Ok(x.value),
@@ -657,7 +665,12 @@ pub(super) fn build(
                         m.geometric_stiffening.unwrap_or(true),
                     );
                     let name = copy_name(&name_of(&m.name), k, count);
-                    out.push(Box::new(ParticleEffector::new(name, beam, &q0, &vec![0.0; n])));
+                    out.push(Box::new(ParticleEffector::new(
+                        name,
+                        beam,
+                        &q0,
+                        &vec![0.0; n],
+                    )));
                 }
             }
         }

@@ -198,10 +198,13 @@ pub enum ConditionSpec {
     /// Nutation angle of the spin axis relative to H (degrees).
     NutationAngleDeg(ThresholdSpec),
     /// Angle between ω and the minimum-inertia principal axis (degrees).
+    #[serde(rename = "angle_to_principal_1_deg")]
     AngleToPrincipal1Deg(ThresholdSpec),
     /// Angle between ω and the intermediate principal axis (degrees).
+    #[serde(rename = "angle_to_principal_2_deg")]
     AngleToPrincipal2Deg(ThresholdSpec),
     /// Angle between ω and the maximum-inertia principal axis (degrees).
+    #[serde(rename = "angle_to_principal_3_deg")]
     AngleToPrincipal3Deg(ThresholdSpec),
     /// Body rate about x (rad/s).
     OmegaX(ThresholdSpec),
@@ -967,7 +970,11 @@ impl ScenarioFile {
         if matches!(method, Method::Exact) && !spacecraft.effectors().is_empty() {
             return Err(err(
                 method_loc,
-                if ov.method.is_some() { "--method" } else { "integrator.method" },
+                if ov.method.is_some() {
+                    "--method"
+                } else {
+                    "integrator.method"
+                },
                 "method `exact` solves the torque-free rigid body only, and this spacecraft \
                  has effectors; use dopri5 or rk4"
                     .into(),

@@ -111,8 +111,9 @@ TELEMETRY_FIELDS = (
     "kinetic_energy",
     "nutation_angle_deg",
     "angle_to_principal_1_deg", "angle_to_principal_2_deg", "angle_to_principal_3_deg",
-    "drift_h_rel", "drift_t_rel",
+    "drift_h_rel", "drift_energy_rel",
     "q_norm_error",
+    "elastic_energy", "dissipated_energy", "dissipation_power",
 )
 
 NUMERIC_TYPES = {
@@ -251,6 +252,7 @@ class McapCheck:
         self.spin_z = spin_z
         self.checks = Checks()
         self.topic_counts: Counter = Counter()
+        self.effector_samples: dict[str, int] = {}
         self.channel_topics: list[str] = []  # every topic in the summary, even without messages
         self.metadata_names: list[str] = []
         self.attachment_names: list[str] = []
@@ -509,6 +511,19 @@ class McapCheck:
             self._on_scene(log_time, msg)
         elif topic == "/log":
             self._on_log(log_time, msg)
+        elif topic.startswith("/effectors/"):
+            self._on_effector(topic, log_time, msg)
+
+    def _on_effector(self, topic: str, log_time: int, msg: Any) -> None:
+        """Per-effector telemetry: flat doubles, `sim_time` first, every value finite."""
+        fields = [f.name for f in msg.DESCRIPTOR.fields]
+        if not fields or fields[0] != "sim_time":
+            self.checks.fail("effector schema", f"{topic}: first field is not sim_time: {fields}")
+            return
+        bad = [f for f in fields if not math.isfinite(float(getattr(msg, f)))]
+        if bad:
+            self.checks.fail("effector finite", f"{topic} {_fmt_t(log_time)}: non-finite {bad}")
+        self.effector_samples[topic] = self.effector_samples.get(topic, 0) + 1
 
     def _on_tf(self, log_time: int, msg: Any) -> None:
         where = f"/tf {_fmt_t(log_time)}"
