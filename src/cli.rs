@@ -4,7 +4,7 @@
 //! 1 an I/O failure during the run; 3 the integration failed (the log up to the failure is
 //! kept, marked partial); 130 interrupted by Ctrl-C (the log is kept, marked partial).
 
-use crate::linearize::{Linearization, linearize, spin_rate_of};
+use crate::linearize::{Linearization, linearize, linearize_driven, spin_rate_of};
 use crate::log::McapLogger;
 use crate::model::RigidBody;
 use crate::scenario::{self, Overrides, Scenario};
@@ -154,6 +154,51 @@ fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
         Ok(s) => s,
         Err(c) => return c,
     };
+    if let Some(motion) = s.spacecraft.motion() {
+        // A driven hub: the effectors' modes at the rate the motion reaches at the end.
+        let omega = motion.omega(s.duration);
+        let lin = match linearize_driven(&s.spacecraft, &omega) {
+            Ok(l) => l,
+            Err(m) => {
+                eprintln!("error: {}: {m}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+        };
+        let text = serde_json::to_string_pretty(&lin).unwrap_or_default();
+        if let Some(p) = json {
+            if p == Path::new("-") {
+                println!("{text}");
+                return 0;
+            }
+            if let Err(e) = write_atomically(p, text.as_bytes()) {
+                eprintln!("error: cannot write {}: {e}", p.display());
+                return EXIT_BAD_INPUT;
+            }
+        }
+        println!(
+            "{}: hub driven ({}); effector modes at ω = [{:.6}, {:.6}, {:.6}] rad/s (the rate \
+             at t = {} s)",
+            s.name,
+            motion.describe(),
+            omega[0],
+            omega[1],
+            omega[2],
+            s.duration
+        );
+        println!(
+            "  {:>16} {:>16}  {:<12} time constant",
+            "Re (1/s)", "Im (rad/s)", "mode"
+        );
+        for m in &lin.modes {
+            let tc = m
+                .time_constant
+                .map(|t| format!("{t:.6} s"))
+                .unwrap_or_else(|| "-".into());
+            println!("  {:>16.9e} {:>16.9e}  {:<12} {tc}", m.re, m.im, m.kind);
+        }
+        println!("  verdict: {}", lin.verdict);
+        return 0;
+    }
     let rate = spin_rate_of(&s.spacecraft, &s.omega0);
     let lin = match linearize(&s.spacecraft, rate) {
         Ok(l) => l,
@@ -631,11 +676,17 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
             "  {energy}: |H| {:.3e}  H_N {:.3e}  {label} {:.3e}  |q| {:.3e}",
             o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
         );
+    } else if s.spacecraft.conserves_energy() {
+        println!(
+            "  change (external torque): |H| {:.3e}  H_N {:.3e}; {energy}: {label} {:.3e}  \
+             |q| {:.3e}",
+            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
+        );
     } else {
         println!(
-            "  change (external torque or prescribed motion): |H| {:.3e}  H_N {:.3e}; \
-             {energy}: {label} {:.3e}  |q| {:.3e}",
-            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
+            "  prescribed hub motion: momentum and energy are not conserved; {energy}: |q| \
+             {:.3e}",
+            o.drift.q_norm
         );
     }
     println!(
