@@ -11,7 +11,7 @@ use polhode::integrate::{Dopri5, OdeSystem, Stepper, Tolerances};
 use polhode::linearize::linearize;
 use polhode::model::{RigidBody, Spacecraft};
 use polhode::scenario::{self, Overrides, Scenario};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
