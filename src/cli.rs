@@ -75,6 +75,24 @@ enum Command {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
     },
+    /// Run several fidelities of one scene and print them side by side (no logs written).
+    Compare {
+        /// Scenario YAML files.
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        /// Write a chart of the nutation angle against time (SVG).
+        #[arg(long)]
+        chart: Option<PathBuf>,
+        /// Write the nutation angle series (CSV).
+        #[arg(long)]
+        csv: Option<PathBuf>,
+        /// Write the table as JSON (or print it with `--json -`).
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Simulated duration for every scenario (s), overrides each `duration`.
+        #[arg(long)]
+        duration: Option<f64>,
+    },
     /// Eigenvalues of the linearisation about steady spin about the spin axis.
     Linearize {
         /// Scenario YAML file.
@@ -97,6 +115,19 @@ pub fn main() -> i32 {
     };
     match cli.command {
         Command::Check { scenarios } => check(&scenarios),
+        Command::Compare {
+            scenarios,
+            chart,
+            csv,
+            json,
+            duration,
+        } => compare_cmd(
+            &scenarios,
+            chart.as_deref(),
+            csv.as_deref(),
+            json.as_deref(),
+            duration,
+        ),
         Command::Linearize { scenario, json } => linearize_cmd(&scenario, json.as_deref()),
         Command::Run {
             scenario,
@@ -128,6 +159,86 @@ fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, i32> {
         eprintln!("error: {e}");
         EXIT_BAD_INPUT
     })
+}
+
+fn compare_cmd(
+    paths: &[PathBuf],
+    chart: Option<&Path>,
+    csv: Option<&Path>,
+    json: Option<&Path>,
+    duration: Option<f64>,
+) -> i32 {
+    let overrides = Overrides {
+        duration,
+        ..Overrides::default()
+    };
+    // Validate everything before running anything.
+    let mut scenarios = Vec::new();
+    for p in paths {
+        match load(p, &overrides) {
+            Ok(s) => scenarios.push(s),
+            Err(c) => return c,
+        }
+    }
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let tty = std::io::stderr().is_terminal();
+    let mut rows = Vec::new();
+    let count = scenarios.len();
+    for (i, s) in scenarios.into_iter().enumerate() {
+        if tty {
+            eprintln!("[{}/{count}] {} …", i + 1, s.name);
+        }
+        match crate::compare::run_one(s, &interrupt) {
+            Ok(r) => rows.push(r),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_IO;
+            }
+        }
+        if interrupt.load(Ordering::SeqCst) {
+            eprintln!("interrupted: the table holds the runs finished so far");
+            break;
+        }
+    }
+    let table = crate::compare::table(&rows);
+    let title = format!(
+        "Nutation angle: {}",
+        rows.iter()
+            .map(|r| r.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" vs ")
+    );
+    let mut outputs: Vec<(&Path, String)> = Vec::new();
+    if let Some(p) = chart {
+        outputs.push((p, crate::compare::chart(&rows, &title)));
+    }
+    if let Some(p) = csv {
+        outputs.push((p, crate::compare::series_csv(&rows)));
+    }
+    let json_text = serde_json::to_string_pretty(&rows).unwrap_or_default() + "\n";
+    match json {
+        Some(p) if p == Path::new("-") => print!("{json_text}"),
+        Some(p) => outputs.push((p, json_text)),
+        None => {}
+    }
+    for (p, text) in outputs {
+        if let Err(e) = write_atomically(p, text.as_bytes()) {
+            eprintln!("error: cannot write {}: {e}", p.display());
+            return EXIT_IO;
+        }
+    }
+    if json != Some(Path::new("-")) {
+        print!("{table}");
+    }
+    if interrupt.load(Ordering::SeqCst) {
+        EXIT_INTERRUPTED
+    } else {
+        0
+    }
 }
 
 fn check(paths: &[PathBuf]) -> i32 {

@@ -10,11 +10,13 @@
 //! [`log`] (MCAP output), [`linearize`], and the command-line front end in [`cli`].
 
 pub mod cli;
+pub mod compare;
 pub mod effectors;
 pub mod exact;
 pub mod integrate;
 pub mod linearize;
 pub mod log;
 pub mod model;
+pub mod plot;
 pub mod scenario;
 pub mod sim;

@@ -601,3 +601,139 @@ fn summary_and_log_must_differ() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(!target.exists());
 }
+
+/// A spacecraft with a hinged rod and a damper, for the bad-effector cases below.
+const WITH_EFFECTORS: &str = "name: fx
+body:
+  mass: 10.0
+  principal: [1.0, 2.0, 3.0]
+  spin_axis: [0, 0, 1]
+  shape: {box: {size: [1.0, 1.0, 1.0]}}
+effectors:
+  - hinged_rod:
+      mass: 0.1
+      length: 0.5
+      hinge: [0.5, 0.0, 0.0]
+      direction: [1, 0, 0]
+      axis: [0, 0, 1]
+      stiffness: 1.0
+      damping: 0.1
+  - modal_appendage:
+      length: 2.0
+      bending_stiffness: 10.0
+      mass_per_length: 0.2
+      attachment: [0.0, 0.5, 0.0]
+      direction: [0, 1, 0]
+      flap_direction: [0, 0, 1]
+initial:
+  omega: [0.1, 0.0, 1.0]
+duration: 2.0
+output: {rate: 10}
+";
+
+#[test]
+fn the_effector_template_is_valid() {
+    let dir = scratch("fx-ok");
+    let file = write_scenario(&dir, "ok.yaml", WITH_EFFECTORS);
+    let out = polhode().arg("check").arg(&file).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}
+
+#[test]
+fn unphysical_effectors_are_located_errors() {
+    let cases: [(&str, &str, &str, u32, &str, &str); 7] = [
+        (
+            "neg-mass",
+            "      mass: 0.1",
+            "      mass: -0.1",
+            9,
+            "effectors[0].hinged_rod.mass",
+            "positive",
+        ),
+        (
+            "nan-length",
+            "      length: 0.5",
+            "      length: .nan",
+            10,
+            "effectors[0].hinged_rod.length",
+            "positive",
+        ),
+        (
+            "outside",
+            "      hinge: [0.5, 0.0, 0.0]",
+            "      hinge: [0.9, 0.0, 0.0]",
+            11,
+            "effectors[0].hinged_rod.hinge",
+            "outside the body",
+        ),
+        (
+            "skew-axis",
+            "      axis: [0, 0, 1]",
+            "      axis: [1, 0, 1]",
+            13,
+            "effectors[0].hinged_rod.axis",
+            "perpendicular",
+        ),
+        (
+            "zero-ei",
+            "      bending_stiffness: 10.0",
+            "      bending_stiffness: 0.0",
+            18,
+            "effectors[1].modal_appendage.bending_stiffness",
+            "positive",
+        ),
+        (
+            "neg-damping",
+            "      damping: 0.1",
+            "      damping: -0.1",
+            15,
+            "effectors[0].hinged_rod.damping",
+            "≥ 0",
+        ),
+        ("no-mass", "  mass: 10.0\n", "", 0, "body.mass", "body.mass"),
+    ];
+    for (name, from, to, line, field, expect) in cases {
+        let y = WITH_EFFECTORS.replacen(from, to, 1);
+        assert_ne!(y, WITH_EFFECTORS, "{name}: the replacement must apply");
+        if line == 0 {
+            // Not tied to a line of its own: the message names the field.
+            let dir = scratch(name);
+            let file = write_scenario(&dir, "bad.yaml", &y);
+            let out = polhode().arg("check").arg(&file).output().unwrap();
+            let err = stderr(&out);
+            assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+            assert!(err.contains(field) && err.contains(expect), "{name}: {err}");
+        } else {
+            assert_rejected(name, y.as_bytes(), line, field, expect);
+        }
+    }
+}
+
+#[test]
+fn compare_prints_the_fidelities_side_by_side() {
+    let dir = scratch("compare");
+    let rigid = write_scenario(&dir, "rigid.yaml", GOOD);
+    let fx = write_scenario(&dir, "fx.yaml", WITH_EFFECTORS);
+    let chart = dir.join("chart.svg");
+    let json = dir.join("table.json");
+    let out = polhode()
+        .args(["compare"])
+        .arg(&rigid)
+        .arg(&fx)
+        .arg("--chart")
+        .arg(&chart)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("good") && text.contains("hinged_rod + modal_appendage"),
+        "{text}"
+    );
+    let rows = read_json(&json);
+    assert_eq!(rows.as_array().unwrap().len(), 2);
+    assert_eq!(rows[0]["states"], 7);
+    assert!(std::fs::read_to_string(&chart).unwrap().starts_with("<svg"));
+}

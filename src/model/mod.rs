@@ -397,6 +397,28 @@ impl Spacecraft {
         inertia
     }
 
+    /// Angle (rad) between H and the maximum-inertia axis of the spacecraft as configured in
+    /// `y`, and that largest moment (kg m²). When the two largest moments are within 1% of
+    /// each other (a nearly axisymmetric body, whose every transverse axis is a
+    /// maximum-inertia axis), the angle is to the plane they span. A flat spin has this near 0.
+    pub fn angle_to_max_inertia(&self, y: &[f64]) -> (f64, f64) {
+        let inertia = self.system_inertia(y);
+        let eig = inertia.symmetric_eigen();
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+        let [min, mid, max] = order;
+        let h = self.invariants(0.0, y).h_body;
+        let i_max = eig.eigenvalues[max];
+        let axis_angle = |c: usize| observe::angle_between(&h, &eig.eigenvectors.column(c).into());
+        let angle = if i_max - eig.eigenvalues[mid] < 1e-2 * i_max {
+            (std::f64::consts::FRAC_PI_2 - axis_angle(min)).abs()
+        } else {
+            let a = axis_angle(max);
+            a.min(std::f64::consts::PI - a)
+        };
+        (angle, i_max)
+    }
+
     /// Hub acceleration ω̇ (rad/s²) for the hub-only case: `I⁻¹ (−ω × Iω)`.
     #[inline(always)]
     fn rigid_omega_dot(&self, omega: &Vector3<f64>) -> Vector3<f64> {
