@@ -8,6 +8,8 @@
 //!    system, against a minimal hand-written RK4 loop on `[f64; 7]` with the same equations.
 //! 2. A run that logs MCAP at 100 Hz against the same run without logging, on a cheap
 //!    adaptive scene (integration much cheaper than a sample) and a fixed-step one.
+//! 3. The cost of one right-hand-side evaluation of each shipped scene with effectors,
+//!    against the rigid body's (a scene pays only for the effects it includes).
 //!
 //! Each measurement is the minimum over repeats, and the two sides alternate so that both see
 //! the same machine load.
@@ -137,9 +139,57 @@ fn bench_logging(repeats: usize, label: &str, method: &str, dt: Option<f64>) {
     );
 }
 
+/// One right-hand-side evaluation of each scene, against the rigid body's, alternating.
+fn bench_effector_rhs(repeats: usize) {
+    use polhode::integrate::OdeSystem;
+    let rigid = scenario::load(Path::new("scenarios/generic-tumble.yaml"), &Overrides::default())
+        .expect("scenario");
+    let calls = 20_000;
+    fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
+        let sc = &s.spacecraft;
+        let y = sc.initial_state(&s.omega0, &s.attitude0);
+        let mut dy = vec![0.0; sc.dim()];
+        move || {
+            for _ in 0..calls {
+                sc.rhs(0.0, black_box(&y), &mut dy);
+                black_box(&dy);
+            }
+        }
+    }
+    println!("\none right-hand-side evaluation, against the rigid body (7 states):");
+    for file in [
+        "wheel-damper",
+        "nutation-damper",
+        "explorer1-pydy-energy-sink",
+        "explorer1",
+        "flexible-boom",
+        "explorer1-pydy-modal",
+    ] {
+        let s = scenario::load(
+            Path::new(&format!("scenarios/{file}.yaml")),
+            &Overrides::default(),
+        )
+        .expect("scenario");
+        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
+        let mut f_base = time_rhs(&rigid, calls);
+        let mut f = time_rhs(&s, calls);
+        for _ in 0..repeats {
+            base_best = base_best.min(min_time(1, &mut f_base));
+            best = best.min(min_time(1, &mut f));
+        }
+        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
+        println!(
+            "  {file:<28} {:>3} states  {ns:>9.1} ns  rigid {base_ns:>6.1} ns  ratio {:>7.1}",
+            s.spacecraft.dim(),
+            ns / base_ns
+        );
+    }
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 15 };
+    bench_effector_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(
         repeats,

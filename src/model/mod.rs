@@ -542,7 +542,13 @@ impl Spacecraft {
 #[inline(always)]
 fn solve_hub(c: &HubCoupling) -> HubAcceleration {
     if c.translation {
-        match c.mass.lu().solve(&c.force) {
+        // The generalised mass is symmetric positive definite: Cholesky (LU if rounding
+        // spoils definiteness).
+        let solved = match c.mass.cholesky() {
+            Some(ch) => Some(ch.solve(&c.force)),
+            None => c.mass.lu().solve(&c.force),
+        };
+        match solved {
             Some(z) => HubAcceleration {
                 linear: Vector3::new(z[0], z[1], z[2]),
                 angular: Vector3::new(z[3], z[4], z[5]),
@@ -558,8 +564,8 @@ fn solve_hub(c: &HubCoupling) -> HubAcceleration {
         HubAcceleration {
             linear: Vector3::zeros(),
             angular: m_rr
-                .lu()
-                .solve(&f_r)
+                .try_inverse()
+                .map(|inv| inv * f_r)
                 .unwrap_or_else(|| Vector3::repeat(f64::NAN)),
         }
     }
