@@ -142,8 +142,11 @@ fn bench_logging(repeats: usize, label: &str, method: &str, dt: Option<f64>) {
 /// One right-hand-side evaluation of each scene, against the rigid body's, alternating.
 fn bench_effector_rhs(repeats: usize) {
     use polhode::integrate::OdeSystem;
-    let rigid = scenario::load(Path::new("scenarios/generic-tumble.yaml"), &Overrides::default())
-        .expect("scenario");
+    let rigid = scenario::load(
+        Path::new("scenarios/generic-tumble.yaml"),
+        &Overrides::default(),
+    )
+    .expect("scenario");
     let calls = 20_000;
     fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
         let sc = &s.spacecraft;

@@ -125,13 +125,16 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let rest = sc.rest_state(&Vector3::zeros(), &UnitQuaternion::identity());
     let inertia = sc.system_inertia(&rest);
     let (p, axes) = principal(&inertia);
-    let (principal_index, alignment) = (0..3)
-        .map(|c| (c, axes.column(c).dot(&s).abs()))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .unwrap_or((2, 0.0));
-    let misalignment = (1.0 - alignment.min(1.0)).max(0.0);
-    if misalignment > 1e-9 {
-        let a = axes.column(principal_index);
+    // ŝ is a principal axis when I ŝ is parallel to it (this also accepts any axis of a
+    // plane of equal moments, where the computed eigenvectors are arbitrary).
+    let i_s = s.dot(&(inertia * s));
+    let off_axis = (inertia * s - s * i_s).norm() / inertia.norm();
+    if off_axis > 1e-9 {
+        let (nearest, _) = (0..3)
+            .map(|c| (c, axes.column(c).dot(&s).abs()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((2, 0.0));
+        let a = axes.column(nearest);
         return Err(format!(
             "the spin axis [{:.6}, {:.6}, {:.6}] is not a principal axis of the spacecraft \
              (nearest: axis {} = [{:.6}, {:.6}, {:.6}], off by {:.3e}°), so no steady spin \
@@ -139,13 +142,17 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             s[0],
             s[1],
             s[2],
-            principal_index + 1,
+            nearest + 1,
             a[0],
             a[1],
             a[2],
-            (2.0 * misalignment).sqrt().to_degrees()
+            a.dot(&s).abs().min(1.0).acos().to_degrees()
         ));
     }
+    // Which principal moment ŝ carries (1 = minimum … 3 = maximum).
+    let principal_index = (0..3)
+        .min_by(|&a, &b| (p[a] - i_s).abs().total_cmp(&(p[b] - i_s).abs()))
+        .unwrap_or(2);
     if !(spin_rate.is_finite() && spin_rate != 0.0) {
         return Err(format!(
             "the spin rate about the spin axis is {spin_rate} rad/s; a linearisation about \
@@ -586,6 +593,24 @@ pub fn energy_sink_coefficient(
     };
     if !(tau.is_finite() && tau > 0.0) {
         return Err(format!("expected a positive time constant, got {tau}"));
+    }
+    if !(spin_rate.is_finite() && spin_rate != 0.0) {
+        return Err(format!(
+            "the initial spin rate about the spin axis is {spin_rate} rad/s; a nutation time \
+             constant needs a spin"
+        ));
+    }
+    let probe = {
+        let sc = Spacecraft::new(hub.clone(), spin_axis);
+        linearize(&sc, spin_rate)?
+    };
+    if probe.principal_axis == 2 {
+        return Err(
+            "the spin axis is the intermediate axis, whose spin is unstable without \
+                    any dissipation; an energy-sink time constant is defined for minor- and \
+                    major-axis spins"
+                .into(),
+        );
     }
     let target = 1.0 / tau;
     // Scan c over decades (in units of I_s |Ω|) for the first bracket, then bisect in log c.

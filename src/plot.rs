@@ -17,7 +17,7 @@
 //!   visual envelope.
 //!
 //! ```
-//! use plot::plot::{Chart, Series, Style};
+//! use polhode::plot::{Chart, Series, Style};
 //! let mut chart = Chart::new("Nutation", "time [s]", "angle [deg]");
 //! chart.series.push(Series::new("rigid", vec![(0.0, 1.0), (1.0, 0.5)], Style::Line));
 //! let svg = chart.to_svg(640, 400);

@@ -737,3 +737,62 @@ fn compare_prints_the_fidelities_side_by_side() {
     assert_eq!(rows[0]["states"], 7);
     assert!(std::fs::read_to_string(&chart).unwrap().starts_with("<svg"));
 }
+
+#[test]
+fn inconsistent_effector_combinations_are_refused() {
+    let wheel = "  - wheel_damper: {inertia: 3.0, axis: [1, 1, 0], damping: 1.0}\n";
+    let cases = [
+        // 1 / (âᵀ I⁻¹ â) = 1.82 kg m² for this axis, though âᵀ I â = 5.5.
+        (
+            "big-wheel",
+            WITH_EFFECTORS
+                .replace("principal: [1.0, 2.0, 3.0]", "principal: [1.0, 10.0, 10.0]")
+                .replace("effectors:\n", &format!("effectors:\n{wheel}")),
+            "effectors[0].wheel_damper.inertia",
+        ),
+        (
+            "copy-outside",
+            // The hinge is on the +x face of a flattened box; turned about y, two copies
+            // land 0.2 m above and below it.
+            WITH_EFFECTORS
+                .replace("size: [1.0, 1.0, 1.0]", "size: [1.0, 1.0, 0.6]")
+                .replace(
+                    "      damping: 0.1\n",
+                    "      damping: 0.1\n      copies: {count: 4, about: [0, 1, 0]}\n",
+                ),
+            "effectors[0].hinged_rod.copies",
+        ),
+        (
+            "sink-with-rod",
+            WITH_EFFECTORS.replace(
+                "effectors:\n",
+                "effectors:\n  - energy_sink: {coefficient: 0.1}\n",
+            ),
+            "effectors[0].energy_sink",
+        ),
+        (
+            "sink-intermediate",
+            GOOD.replace("spin_axis: [0, 0, 1]", "spin_axis: [0, 1, 0]")
+                .replace("omega: [0.1, 0.0, 1.0]", "omega: [0.1, 1.0, 0.0]")
+                + "effectors:\n  - energy_sink: {time_constant: 10.0}\n",
+            "effectors[0].energy_sink.time_constant",
+        ),
+        (
+            "motion-start",
+            WITH_EFFECTORS.replace(
+                "initial:",
+                "hub_motion: {spin_up: {axis: [0, 0, 1], rate: 1.0, ramp_time: 5.0}}\ninitial:",
+            ),
+            "initial.omega",
+        ),
+    ];
+    for (name, yaml, field) in cases {
+        let dir = scratch(name);
+        let file = write_scenario(&dir, "bad.yaml", &yaml);
+        let out = polhode().arg("check").arg(&file).output().unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(&format!("field `{field}`")), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+}

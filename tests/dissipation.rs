@@ -393,7 +393,7 @@ fn spin_up_tip(stiffening: bool) -> (f64, bool) {
     (largest, false)
 }
 
-/// Geometric stiffening: the spun beam stays within centimetres; the conventional model
+/// Geometric stiffening: the spun beam's tip stays below the quasi-static estimate; the conventional model
 /// (no foreshortening) diverges once the spin exceeds its first frequency.
 #[test]
 fn spin_up_stays_bounded_with_stiffening_and_diverges_without() {

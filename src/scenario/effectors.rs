@@ -287,8 +287,10 @@ impl Check<'_> {
     }
     fn unit(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
         let v = Vector3::from(s.value);
-        if v.iter().all(|x| x.is_finite()) && v.norm() > 0.0 {
-            Ok(v.normalize())
+        // Scale first, so that huge or tiny components neither overflow nor underflow.
+        let m = v.amax();
+        if v.iter().all(|x| x.is_finite()) && m > 0.0 {
+            Ok((v / m).normalize())
         } else {
             Err(self.err(s, key, "expected a non-zero vector of three finite numbers"))
         }
@@ -508,20 +510,21 @@ pub(super) fn build(
                         None => Vector3::zeros(),
                     },
                 }));
-                // The rotor is part of the body's inertia: it cannot exceed it about its axis.
-                let a = out.last().map(|_| ck.unit(&w.axis, "axis")).transpose()?;
-                if let Some(a) = a {
-                    let about_axis = a.dot(&(cx.hub.inertia * a));
-                    if w.inertia.value >= about_axis {
-                        return Err(ck.err(
-                            &w.inertia,
-                            "inertia",
-                            format!(
-                                "the rotor's inertia must be less than the body's about the \
-                                 same axis ({about_axis} kg m²), which includes it"
-                            ),
-                        ));
-                    }
+                // The rotor is part of the body's inertia: I − I_W â âᵀ must stay positive
+                // definite, i.e. I_W âᵀ I⁻¹ â < 1 (stricter than I_W < âᵀ I â off the
+                // principal axes).
+                let a = ck.unit(&w.axis, "axis")?;
+                let limit = 1.0 / a.dot(&(cx.hub.inertia_inv * a));
+                if w.inertia.value >= limit {
+                    return Err(ck.err(
+                        &w.inertia,
+                        "inertia",
+                        format!(
+                            "the rotor's inertia must be less than 1 / (âᵀ I⁻¹ â) = {limit} kg m² \
+                             for this axis: the body's inertia includes the rotor, and the rest \
+                             of the body must keep a positive-definite inertia"
+                        ),
+                    ));
                 }
             }
             EffectorSpec::HingedRod(h) => {
@@ -570,6 +573,7 @@ pub(super) fn build(
                     HingeFreedom::Lag => (vec![a0[1]], vec![r0[1]]),
                 };
                 let rotations = ck.copies(&h.copies)?;
+                check_copies_on_body(&ck, &h.copies, &rotations, &hinge, cx.shape)?;
                 let count = rotations.len();
                 for (k, rot) in rotations.into_iter().enumerate() {
                     let rod = HingedRod {
@@ -643,6 +647,7 @@ pub(super) fn build(
                 };
                 let tip_phi = modes.nodes[modes.tip].phi[0];
                 let rotations = ck.copies(&m.copies)?;
+                check_copies_on_body(&ck, &m.copies, &rotations, &attachment, cx.shape)?;
                 let count = rotations.len();
                 for (k, rot) in rotations.into_iter().enumerate() {
                     let mut bending = Vec::new();
@@ -675,7 +680,57 @@ pub(super) fn build(
             }
         }
     }
+    // The energy sink is the quasi-rigid model: its Ĥ is the hub's Iω, so it keeps |H| only
+    // when no other effector carries momentum.
+    let sink = specs
+        .iter()
+        .position(|s| matches!(s, EffectorSpec::EnergySink(_)));
+    if let Some(i) = sink
+        && out
+            .iter()
+            .any(|e| e.moves_mass() || e.kind() == "wheel_damper")
+    {
+        return Err(ScenarioError::at(
+            cx.path,
+            None,
+            format!("effectors[{i}].energy_sink"),
+            "an energy sink models the internal dissipation of a quasi-rigid body and cannot \
+             be combined with effectors that carry momentum of their own (dampers, rods, \
+             beams, wheels): model the dissipation with those instead",
+        ));
+    }
     Ok(out)
+}
+
+/// Every copy's point must be on or in the body too.
+fn check_copies_on_body(
+    ck: &Check,
+    spec: &Option<CopiesSpec>,
+    rotations: &[UnitQuaternion<f64>],
+    point: &Vector3<f64>,
+    shape: &Shape,
+) -> Result<(), ScenarioError> {
+    let Some(c) = spec else {
+        return Ok(());
+    };
+    for (k, rot) in rotations.iter().enumerate() {
+        let p = rot * point;
+        if let Some(excess) = outside(shape, &p) {
+            return Err(ck.err(
+                &c.about,
+                "copies",
+                format!(
+                    "copy {} lands at [{:.4}, {:.4}, {:.4}] m, outside the body by {excess:.4} m; \
+                     every copy must be on or inside the hub's shape",
+                    k + 1,
+                    p[0],
+                    p[1],
+                    p[2]
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn copy_name(base: &str, k: usize, count: usize) -> String {

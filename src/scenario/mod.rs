@@ -965,7 +965,27 @@ impl ScenarioFile {
             })?;
         }
         if let Some(m) = &self.hub_motion {
-            spacecraft.set_motion(Box::new(effectors::motion(path, m)?));
+            let motion = effectors::motion(path, m)?;
+            // The state's ω integrates the prescribed ω̇, so it must start at the motion's ω(0).
+            use crate::model::HubMotion;
+            let start = motion.omega(0.0);
+            if (omega0 - start).norm() > 1e-12 * (1.0 + start.norm()) {
+                let l = self.initial.omega.as_ref().and_then(loc).or(self
+                    .initial
+                    .omega_rpm
+                    .as_ref()
+                    .and_then(loc));
+                return Err(err(
+                    l,
+                    "initial.omega",
+                    format!(
+                        "with `hub_motion` the initial rates must be the motion's at t = 0, \
+                         [{}, {}, {}] rad/s",
+                        start[0], start[1], start[2]
+                    ),
+                ));
+            }
+            spacecraft.set_motion(Box::new(motion));
         }
         if matches!(method, Method::Exact) && !spacecraft.effectors().is_empty() {
             return Err(err(
