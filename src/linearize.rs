@@ -245,6 +245,20 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         })
         .flatten();
     let nutation_value = nutation_index.map(|k| eig[k]);
+    // The intermediate axis's rigid pair is ±k (real): its decaying partner, the eigenvalue
+    // nearest −k, belongs to the nutation too. (A complex mode's partner is its conjugate.)
+    let partner = (rigid.growth_rate > 0.0)
+        .then(|| {
+            eig.iter()
+                .filter(|z| z.norm() > zero)
+                .min_by(|a, b| {
+                    (*a + rigid_eigenvalue)
+                        .norm()
+                        .total_cmp(&(*b + rigid_eigenvalue).norm())
+                })
+                .copied()
+        })
+        .flatten();
 
     // One zero eigenvalue belongs to the spin itself (a change of spin rate is steady too).
     // Further zero eigenvalues make the linearisation degenerate (e.g. a symmetric body spun
@@ -272,10 +286,11 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             } else {
                 "neutral"
             };
-            if let Some(v) = nutation_value
-                && (z.re - v.re).abs() <= 1e-12 * v.norm()
-                && (z.im.abs() - v.im.abs()).abs() <= 1e-12 * v.norm()
-            {
+            let same = |v: C64| {
+                (z.re - v.re).abs() <= 1e-12 * v.norm()
+                    && (z.im.abs() - v.im.abs()).abs() <= 1e-12 * v.norm()
+            };
+            if nutation_value.is_some_and(same) || partner.is_some_and(same) {
                 role = "nutation";
             }
             Mode {
@@ -677,6 +692,8 @@ mod tests {
             max_relative = 1e-12
         );
         assert_eq!(lin.modes.iter().filter(|m| m.kind == "spin").count(), 1);
+        // A rigid body has no effector modes: ±k are both the nutation's.
+        assert_eq!(lin.modes.iter().filter(|m| m.role == "nutation").count(), 2);
     }
 
     #[test]
