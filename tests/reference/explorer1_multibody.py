@@ -29,7 +29,7 @@ computed by hand-written numpy code that does NOT use the sympy derivation,
 so conservation of H and of T + V + E_dissipated checks the EOM.
 
 Usage: python explorer1_multibody.py [t_end]   (default 150)
-Writes explorer1_multibody.csv next to this script.
+Writes ../data/explorer1_multibody.csv (tests/data/).
 """
 import os
 import sys
@@ -333,7 +333,7 @@ def main():
     ok = maxdH <= 1e-9 and maxdE <= 1e-9
     print("SELF-CHECK", "PASSED" if ok else "FAILED")
 
-    out = os.path.join(HERE, "explorer1_multibody.csv")
+    out = os.path.join(HERE, "..", "data", "explorer1_multibody.csv")
     with open(out, "w") as fh:
         fh.write("# Explorer 1 multibody reference: rigid hub (hollow tube, translating freely) + 4 thin\n")
         fh.write("#   uniform rods on 2-axis universal joints (flap th_f, lag th_l) with torsional springs/dampers;\n")

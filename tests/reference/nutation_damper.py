@@ -23,7 +23,7 @@ between output times.
 |H| (about the system CM), T (CM frame), momentum, CM position are computed by
 hand-written numpy code independent of the sympy derivation.
 
-Usage: python nutation_damper.py      Writes nutation_damper.csv next to this script.
+Usage: python nutation_damper.py      Writes ../data/nutation_damper.csv (tests/data/).
 """
 import os
 import time
@@ -216,7 +216,7 @@ def main():
     ok = mx["dH"] <= 1e-9 and mx["dE"] <= 1e-9
     print("SELF-CHECK", "PASSED" if ok else "FAILED")
 
-    out = os.path.join(HERE, "nutation_damper.csv")
+    out = os.path.join(HERE, "..", "data", "nutation_damper.csv")
     with open(out, "w") as fh:
         fh.write("# Spring-mass nutation damper reference (Roithmayr & Hodges data): rigid bus (translating freely)\n")
         fh.write("#   + particle sliding on a bus-fixed line parallel to hub z with spring and dashpot;\n")
