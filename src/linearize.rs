@@ -112,6 +112,47 @@ fn principal(i: &Matrix3<f64>) -> ([f64; 3], Matrix3<f64>) {
     (moments, axes)
 }
 
+/// Positions and names (`<effector>.<state>`) of the effectors' dynamic states.
+fn dynamic_states(sc: &Spacecraft) -> (Vec<usize>, Vec<String>) {
+    let mut idx = Vec::new();
+    let mut names = Vec::new();
+    for (k, e) in sc.effectors().iter().enumerate() {
+        let off = sc.effector_offset(k);
+        let state_names = e.state_names();
+        for (j, state) in state_names.iter().enumerate().take(e.num_dynamic_states()) {
+            idx.push(off + j);
+            names.push(format!("{}.{state}", e.name()));
+        }
+    }
+    (idx, names)
+}
+
+/// Central-difference Jacobian of `f` (which writes `rows` outputs) with respect to the
+/// entries `cols` of `y0`, with step `step(j)` for entry j.
+fn central_jacobian(
+    y0: &[f64],
+    cols: &[usize],
+    rows: usize,
+    step: impl Fn(usize) -> f64,
+    mut f: impl FnMut(&[f64], &mut Vec<f64>),
+) -> DMatrix<f64> {
+    let mut jac = DMatrix::<f64>::zeros(rows, cols.len());
+    let (mut fp, mut fm) = (Vec::new(), Vec::new());
+    for (col, &j) in cols.iter().enumerate() {
+        let h = step(j);
+        let mut yp = y0.to_vec();
+        let mut ym = y0.to_vec();
+        yp[j] += h;
+        ym[j] -= h;
+        f(&yp, &mut fp);
+        f(&ym, &mut fm);
+        for r in 0..rows {
+            jac[(r, col)] = (fp[r] - fm[r]) / (2.0 * h);
+        }
+    }
+    jac
+}
+
 /// Linearises `sc` about steady spin at `spin_rate` (rad/s) about its spin axis.
 pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, String> {
     if sc.motion().is_some() {
@@ -164,19 +205,13 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let y_eq = sc.rest_state(&omega, &UnitQuaternion::identity());
     let n = sc.dim();
     // Linearised coordinates: ω and the effectors' dynamic states.
-    let mut idx: Vec<usize> = (0..3).collect();
-    let mut names: Vec<String> = ["omega_x", "omega_y", "omega_z"]
+    let (effector_idx, effector_names) = dynamic_states(sc);
+    let idx: Vec<usize> = (0..3).chain(effector_idx).collect();
+    let names: Vec<String> = ["omega_x", "omega_y", "omega_z"]
         .iter()
         .map(|s| s.to_string())
+        .chain(effector_names)
         .collect();
-    for (k, e) in sc.effectors().iter().enumerate() {
-        let off = sc.effector_offset(k);
-        let state_names = e.state_names();
-        for (j, state) in state_names.iter().enumerate().take(e.num_dynamic_states()) {
-            idx.push(off + j);
-            names.push(format!("{}.{state}", e.name()));
-        }
-    }
     let scale = spin_rate.abs();
     let mut f0 = vec![0.0; n];
     sc.rhs(0.0, &y_eq, &mut f0);
@@ -191,24 +226,19 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         })
         .fold(0.0, f64::max);
     let m = idx.len();
-    let mut jac = DMatrix::<f64>::zeros(m, m);
-    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
-    for (col, &j) in idx.iter().enumerate() {
-        let h = if j < HUB_STATES {
+    let mut dy = vec![0.0; n];
+    let step = |j: usize| {
+        if j < HUB_STATES {
             1e-6 * scale.max(1e-3)
         } else {
             1e-6
-        };
-        let mut yp = y_eq.clone();
-        let mut ym = y_eq.clone();
-        yp[j] += h;
-        ym[j] -= h;
-        sc.rhs(0.0, &yp, &mut fp);
-        sc.rhs(0.0, &ym, &mut fm);
-        for (row, &i) in idx.iter().enumerate() {
-            jac[(row, col)] = (fp[i] - fm[i]) / (2.0 * h);
         }
-    }
+    };
+    let jac = central_jacobian(&y_eq, &idx, m, step, |y, out| {
+        sc.rhs(0.0, y, &mut dy);
+        out.clear();
+        out.extend(idx.iter().map(|&i| dy[i]));
+    });
     let eig = jac.clone().complex_eigenvalues();
     let zero = 1e-9 * scale;
 
@@ -373,40 +403,24 @@ pub fn linearize_driven(
     omega: &Vector3<f64>,
 ) -> Result<DrivenLinearization, String> {
     let y_eq = sc.rest_state(omega, &UnitQuaternion::identity());
-    let mut idx = Vec::new();
-    let mut names = Vec::new();
-    for (k, e) in sc.effectors().iter().enumerate() {
-        let off = sc.effector_offset(k);
-        for (j, state) in e
-            .state_names()
-            .iter()
-            .enumerate()
-            .take(e.num_dynamic_states())
-        {
-            idx.push(off + j);
-            names.push(format!("{}.{state}", e.name()));
-        }
-    }
+    let (idx, names) = dynamic_states(sc);
     if idx.is_empty() {
         return Err("no effector has states to linearise".into());
     }
-    let n = sc.dim();
     let m = idx.len();
-    let mut jac = DMatrix::<f64>::zeros(m, m);
-    let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+    let mut dy = vec![0.0; sc.dim()];
     let zero3 = Vector3::zeros();
-    for (col, &j) in idx.iter().enumerate() {
-        let h = 1e-6;
-        let mut yp = y_eq.clone();
-        let mut ym = y_eq.clone();
-        yp[j] += h;
-        ym[j] -= h;
-        sc.rhs_prescribed(0.0, &yp, &zero3, false, &mut fp);
-        sc.rhs_prescribed(0.0, &ym, &zero3, false, &mut fm);
-        for (row, &i) in idx.iter().enumerate() {
-            jac[(row, col)] = (fp[i] - fm[i]) / (2.0 * h);
-        }
-    }
+    let jac = central_jacobian(
+        &y_eq,
+        &idx,
+        m,
+        |_| 1e-6,
+        |y, out| {
+            sc.rhs_prescribed(0.0, y, &zero3, false, &mut dy);
+            out.clear();
+            out.extend(idx.iter().map(|&i| dy[i]));
+        },
+    );
     let eig = jac.complex_eigenvalues();
     let scale = eig.iter().map(|z| z.norm()).fold(0.0, f64::max).max(1e-300);
     let zero = 1e-9 * scale;
@@ -490,40 +504,20 @@ fn energy_sink_estimate(
         })?;
 
     // Jacobians of the effectors' rates with the hub's rotation prescribed (translation free).
-    let f = |y: &[f64], wd: &Vector3<f64>, out: &mut Vec<f64>| {
-        let mut dy = vec![0.0; n];
+    let mut dy = vec![0.0; n];
+    let mut f = |y: &[f64], wd: &Vector3<f64>, out: &mut Vec<f64>| {
         sc.rhs_prescribed(0.0, y, wd, true, &mut dy);
         out.clear();
         out.extend(x_idx.iter().map(|&i| dy[i]));
     };
-    let mut a_xx = DMatrix::<f64>::zeros(nx, nx);
-    let mut b_w = DMatrix::<f64>::zeros(nx, 3);
+    let zero3 = Vector3::zeros();
+    let a_xx = central_jacobian(y_eq, x_idx, nx, |_| 1e-6, |y, out| f(y, &zero3, out));
+    let hw = 1e-6 * omega_eq.norm().max(1e-3);
+    let b_w = central_jacobian(y_eq, &[0, 1, 2], nx, |_| hw, |y, out| f(y, &zero3, out));
+    // ∂/∂ω̇ perturbs the prescribed acceleration, not a state.
     let mut b_wd = DMatrix::<f64>::zeros(nx, 3);
     let (mut fp, mut fm) = (Vec::new(), Vec::new());
-    let zero3 = Vector3::zeros();
-    let h = 1e-6;
-    for (c, &j) in x_idx.iter().enumerate() {
-        let mut yp = y_eq.to_vec();
-        let mut ym = y_eq.to_vec();
-        yp[j] += h;
-        ym[j] -= h;
-        f(&yp, &zero3, &mut fp);
-        f(&ym, &zero3, &mut fm);
-        for r in 0..nx {
-            a_xx[(r, c)] = (fp[r] - fm[r]) / (2.0 * h);
-        }
-    }
-    let hw = 1e-6 * omega_eq.norm().max(1e-3);
     for c in 0..3 {
-        let mut yp = y_eq.to_vec();
-        let mut ym = y_eq.to_vec();
-        yp[c] += hw;
-        ym[c] -= hw;
-        f(&yp, &zero3, &mut fp);
-        f(&ym, &zero3, &mut fm);
-        for r in 0..nx {
-            b_w[(r, c)] = (fp[r] - fm[r]) / (2.0 * hw);
-        }
         let e = Vector3::ith(c, hw);
         f(y_eq, &e, &mut fp);
         f(y_eq, &(-e), &mut fm);

@@ -9,7 +9,7 @@ use polhode::effectors::beam::{BeamProperties, beam_modes};
 use polhode::effectors::{ModalBeam, ParticleEffector, SpinUp, SpringMass, WheelDamper};
 use polhode::integrate::{Dopri5, OdeSystem, Stepper, Tolerances};
 use polhode::linearize::linearize;
-use polhode::model::{RigidBody, Spacecraft};
+use polhode::model::{Observation, RigidBody, Spacecraft};
 use polhode::scenario::{self, Overrides, Scenario};
 use std::path::PathBuf;
 
@@ -60,18 +60,25 @@ fn states_at(sc: &Spacecraft, y0: &[f64], times: &[f64], rtol: f64) -> Vec<Vec<f
         .collect()
 }
 
+/// Each row of a reference CSV with polhode's observation at its time (dopri5, rtol 1e-12).
+fn against_reference(scenario: &str, csv: &str) -> Vec<([f64; 6], Observation)> {
+    let s = load(scenario, Overrides::default());
+    let sc = &s.spacecraft;
+    let rows = reference(csv);
+    let y0 = sc.initial_state(&s.omega0, &s.attitude0);
+    let times: Vec<f64> = rows.iter().map(|r| r[0]).collect();
+    let ys = states_at(sc, &y0, &times, 1e-12);
+    rows.into_iter()
+        .zip(&ys)
+        .map(|(r, y)| (r, sc.observe(r[0], y)))
+        .collect()
+}
+
 /// Explorer 1's documented multibody model against an independent sympy (Kane's method)
 /// model integrated by SciPy's DOP853 at 1e-12: tests/reference/explorer1_multibody.py.
 #[test]
 fn explorer1_pydy_matches_an_independent_multibody_model() {
-    let s = load("explorer1-pydy.yaml", Overrides::default());
-    let sc = &s.spacecraft;
-    let rows = reference("explorer1_multibody.csv");
-    let y0 = sc.initial_state(&s.omega0, &s.attitude0);
-    let times: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    let ys = states_at(sc, &y0, &times, 1e-12);
-    for (r, y) in rows.iter().zip(&ys) {
-        let o = sc.observe(r[0], y);
+    for (r, o) in against_reference("explorer1-pydy.yaml", "explorer1_multibody.csv") {
         let w_ref = Vector3::new(r[1], r[2], r[3]);
         let scale = w_ref.norm();
         let err = (o.omega - w_ref).norm() / scale;
@@ -104,14 +111,7 @@ fn explorer1_pydy_matches_an_independent_multibody_model() {
 /// The Roithmayr & Hodges spring-mass damper against an independent sympy model.
 #[test]
 fn nutation_damper_matches_an_independent_multibody_model() {
-    let s = load("nutation-damper.yaml", Overrides::default());
-    let sc = &s.spacecraft;
-    let rows = reference("nutation_damper.csv");
-    let y0 = sc.initial_state(&s.omega0, &s.attitude0);
-    let times: Vec<f64> = rows.iter().map(|r| r[0]).collect();
-    let ys = states_at(sc, &y0, &times, 1e-12);
-    for (r, y) in rows.iter().zip(&ys) {
-        let o = sc.observe(r[0], y);
+    for (r, o) in against_reference("nutation-damper.yaml", "nutation_damper.csv") {
         let w_ref = Vector3::new(r[1], r[2], r[3]);
         let err = (o.omega - w_ref).norm() / w_ref.norm();
         assert!(err < 1e-9, "t = {}: ω differs by {err:e}", r[0]);
