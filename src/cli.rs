@@ -47,18 +47,8 @@ enum Command {
         /// Do not write an MCAP log.
         #[arg(long, conflicts_with = "out")]
         no_log: bool,
-        /// Integration method: rk4, dopri5 or exact.
-        #[arg(long)]
-        method: Option<String>,
-        /// Fixed step for rk4 (s).
-        #[arg(long)]
-        dt: Option<f64>,
-        /// Relative tolerance for adaptive methods.
-        #[arg(long)]
-        rtol: Option<f64>,
-        /// Absolute tolerance for adaptive methods.
-        #[arg(long)]
-        atol: Option<f64>,
+        #[command(flatten)]
+        method: MethodArgs,
         /// Simulated duration (s), overrides `duration`.
         #[arg(long)]
         duration: Option<f64>,
@@ -93,6 +83,11 @@ enum Command {
         #[arg(long)]
         duration: Option<f64>,
     },
+    /// Benchmarks of the integration methods (docs/choosing-a-method.md).
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
     /// Eigenvalues of the linearisation about steady spin about the spin axis.
     Linearize {
         /// Scenario YAML file.
@@ -101,6 +96,63 @@ enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+}
+
+/// `polhode bench …`.
+#[derive(Subcommand, Debug)]
+enum BenchCommand {
+    /// Time one solve (integration only, minimum of repeats) and print it as JSON.
+    Point {
+        /// Scenario YAML file.
+        scenario: PathBuf,
+        #[command(flatten)]
+        method: MethodArgs,
+        /// Simulated duration (s), overrides `duration`.
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Number of timed solves; the fastest is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+    },
+}
+
+/// Method options shared by `run` and `bench point`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct MethodArgs {
+    /// Integration method: rk4, dopri5, dop853, radau5, gauss, lie, splitting, exact or auto.
+    #[arg(long)]
+    pub method: Option<String>,
+    /// Fixed step for rk4, gauss, lie and splitting (s).
+    #[arg(long)]
+    pub dt: Option<f64>,
+    /// Relative tolerance for adaptive methods.
+    #[arg(long)]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance for adaptive methods.
+    #[arg(long)]
+    pub atol: Option<f64>,
+    /// Stages of gauss: 1 (implicit midpoint) or 2.
+    #[arg(long)]
+    pub stages: Option<u32>,
+    /// Order of splitting: 2 or 4.
+    #[arg(long)]
+    pub order: Option<u32>,
+}
+
+impl MethodArgs {
+    /// The overrides these options make, with `duration` and `mcap`.
+    pub fn overrides(&self, duration: Option<f64>, mcap: Option<PathBuf>) -> Overrides {
+        Overrides {
+            method: self.method.clone(),
+            dt: self.dt,
+            rtol: self.rtol,
+            atol: self.atol,
+            stages: self.stages,
+            order: self.order,
+            duration,
+            mcap,
+        }
+    }
 }
 
 /// Runs the command line; returns the process exit code.
@@ -129,27 +181,44 @@ pub fn main() -> i32 {
             duration,
         ),
         Command::Linearize { scenario, json } => linearize_cmd(&scenario, json.as_deref()),
+        Command::Bench { what } => bench_cmd(what),
         Command::Run {
             scenario,
             out,
             no_log,
             method,
-            dt,
-            rtol,
-            atol,
             duration,
             summary,
             quiet,
         } => {
-            let overrides = Overrides {
-                method,
-                dt,
-                rtol,
-                atol,
-                duration,
-                mcap: out,
-            };
+let overrides = method.overrides(duration, out);
             run(&scenario, &overrides, no_log, summary.as_deref(), quiet)
+        }
+    }
+}
+
+fn bench_cmd(what: BenchCommand) -> i32 {
+    match what {
+        BenchCommand::Point {
+            scenario,
+            method,
+            duration,
+            repeats,
+        } => {
+            let s = match load(&scenario, &method.overrides(duration, None)) {
+                Ok(s) => s,
+                Err(code) => return code,
+            };
+            match crate::bench::point(&s, repeats) {
+                Ok(p) => {
+                    println!("{}", serde_json::to_string(&p).expect("serialisable"));
+                    0
+                }
+                Err(diagnosis) => {
+                    eprintln!("error: {}: {diagnosis}", scenario.display());
+                    EXIT_FAILED
+                }
+            }
         }
     }
 }

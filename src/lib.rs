@@ -9,6 +9,7 @@
 //! [`scenario`] (the YAML contract), [`sim`] (the run loop: sampling, events, invariants),
 //! [`log`] (MCAP output), [`linearize`], and the command-line front end in [`cli`].
 
+pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod effectors;

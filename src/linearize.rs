@@ -895,3 +895,53 @@ mod tests {
         );
     }
 }
+
+/// How stiff the equations are at one state: the fastest local rate against the motion's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stiffness {
+    /// Largest |λ| of the Jacobian of the dynamic states (ω and the effectors' coordinates
+    /// and rates) (1/s): an explicit method's step must stay below about 3/|λ|.
+    pub spectral_radius: f64,
+    /// Largest |Re λ| (1/s): the fastest decay.
+    pub fastest_decay: f64,
+    /// The rate of the motion one wants to resolve: max(|ω|, 1/duration) (1/s).
+    pub motion_rate: f64,
+}
+
+impl Stiffness {
+    /// `spectral_radius / motion_rate`: how many times smaller than the motion's time scale
+    /// an explicit method's stable step is. Above ~1e3 an implicit method pays.
+    pub fn ratio(&self) -> f64 {
+        self.spectral_radius / self.motion_rate
+    }
+}
+
+/// The stiffness of `sc` at `(t, y)` (central-difference Jacobian of the dynamic states,
+/// then its eigenvalues). `duration` (s) bounds the slowest rate of interest.
+pub fn stiffness(sc: &Spacecraft, t: f64, y: &[f64], duration: f64) -> Stiffness {
+    let (effector_idx, _) = dynamic_states(sc);
+    let cols: Vec<usize> = (0..3).chain(effector_idx).collect();
+    let n = y.len();
+    let scale = y.iter().map(|v| v.abs()).fold(0.0, f64::max).max(1e-3);
+    let full = central_jacobian(
+        y,
+        &cols,
+        n,
+        |j| 1e-6 * y[j].abs().max(1e-3 * scale),
+        |yy, out| {
+            out.resize(n, 0.0);
+            sc.rhs(t, yy, out);
+        },
+    );
+    let m = cols.len();
+    let jac = DMatrix::from_fn(m, m, |r, c| full[(cols[r], c)]);
+    let eig = jac.complex_eigenvalues();
+    let spectral_radius = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
+    let fastest_decay = eig.iter().map(|l| (-l.re).max(0.0)).fold(0.0, f64::max);
+    let omega = Vector3::new(y[0], y[1], y[2]).norm();
+    Stiffness {
+        spectral_radius,
+        fastest_decay,
+        motion_rate: omega.max(1.0 / duration),
+    }
+}

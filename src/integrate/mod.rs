@@ -7,11 +7,14 @@
 //! operations.
 
 mod dopri5;
+mod gauss;
+pub mod jacobian;
 mod rk4;
 #[cfg(test)]
 mod test_systems;
 
 pub use dopri5::Dopri5;
+pub use gauss::{Gauss, GaussStages};
 pub use rk4::Rk4;
 
 use std::fmt;
@@ -31,8 +34,14 @@ pub struct Stats {
     pub steps: u64,
     /// Rejected steps (adaptive methods).
     pub rejected_steps: u64,
-    /// Right-hand-side evaluations.
+    /// Right-hand-side evaluations (including those spent on finite-difference Jacobians).
     pub rhs_evaluations: u64,
+    /// Newton iterations (implicit methods).
+    pub newton_iterations: u64,
+    /// Jacobian evaluations (implicit methods).
+    pub jacobian_evaluations: u64,
+    /// LU factorisations of the iteration matrix (implicit methods).
+    pub factorizations: u64,
 }
 
 /// Why a step could not be taken.
@@ -50,6 +59,21 @@ pub enum StepError {
         /// Time at which it happened (s).
         t: f64,
     },
+    /// The Newton iteration of an implicit method did not converge, even after the step was
+    /// reduced (or, for a fixed-step method, at the given step).
+    NewtonFailure {
+        /// Time at which the step failed (s).
+        t: f64,
+        /// Step size that was tried last (s).
+        h: f64,
+    },
+    /// A sub-flow of a composition method could not be evaluated.
+    SubFlow {
+        /// Time at which the step started (s).
+        t: f64,
+        /// What failed.
+        what: String,
+    },
 }
 
 impl fmt::Display for StepError {
@@ -65,6 +89,14 @@ impl fmt::Display for StepError {
                 "the right-hand side became non-finite at t = {t} s: the state left the domain \
                  of the model"
             ),
+            StepError::NewtonFailure { t, h } => write!(
+                f,
+                "the Newton iteration of the implicit method did not converge at t = {t} s \
+                 (h = {h:e} s): reduce the step, or check the model for a singularity"
+            ),
+            StepError::SubFlow { t, what } => {
+                write!(f, "a sub-flow failed in the step from t = {t} s: {what}")
+            }
         }
     }
 }

@@ -141,10 +141,10 @@ pub struct QuaternionSpec {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSpec {
-    /// `rk4`, `dopri5` or `exact`.
+    /// One of [`Method::NAMES`].
     #[serde(default)]
     pub method: Option<Spanned<String>>,
-    /// Fixed step (s), for `rk4`.
+    /// Fixed step (s), for `rk4`, `gauss`, `lie` and `splitting`.
     #[serde(default)]
     pub dt: Option<Spanned<f64>>,
     /// Relative tolerance, for adaptive methods.
@@ -156,6 +156,12 @@ pub struct IntegratorSpec {
     /// Largest step (s), for adaptive methods.
     #[serde(default)]
     pub max_step: Option<Spanned<f64>>,
+    /// Stages of `gauss`: 1 (implicit midpoint) or 2 (default).
+    #[serde(default)]
+    pub stages: Option<Spanned<u32>>,
+    /// Order of `splitting`: 2 (Strang) or 4 (default).
+    #[serde(default)]
+    pub order: Option<Spanned<u32>>,
 }
 
 /// `output:` sampling and log file.
@@ -292,7 +298,29 @@ impl Condition {
     }
 }
 
-/// The integration method and its settings, validated.
+/// Tolerances and step cap of an adaptive method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Adaptive {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Largest step (s).
+    pub max_step: f64,
+}
+
+impl Adaptive {
+    fn describe(&self) -> String {
+        let cap = if self.max_step.is_finite() {
+            format!(", max_step {:e} s", self.max_step)
+        } else {
+            String::new()
+        };
+        format!("rtol {:e}, atol {:e}{cap}", self.rtol, self.atol)
+    }
+}
+
+/// The integration method and its settings, validated (see docs/choosing-a-method.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
     /// Classic RK4 with fixed step `dt` (s).
@@ -301,27 +329,61 @@ pub enum Method {
         dt: f64,
     },
     /// Adaptive Dormand–Prince 5(4).
-    Dopri5 {
-        /// Relative tolerance.
-        rtol: f64,
-        /// Absolute tolerance.
-        atol: f64,
-        /// Largest step (s).
-        max_step: f64,
+    Dopri5(Adaptive),
+    /// Adaptive Dormand–Prince 8(5,3) (Hairer's DOP853).
+    Dop853(Adaptive),
+    /// Adaptive Radau IIA of order 5 (L-stable, implicit): for stiff effectors.
+    Radau5(Adaptive),
+    /// Gauss–Legendre collocation with a fixed step: implicit midpoint (1 stage, order 2) or
+    /// 2 stages (order 4). Keeps every quadratic invariant of the free body.
+    Gauss {
+        /// Step (s).
+        dt: f64,
+        /// Stages: 1 or 2.
+        stages: u8,
+    },
+    /// Runge–Kutta–Munthe-Kaas of order 4 with a fixed step: the attitude advances by
+    /// exponentials, so it stays a unit quaternion.
+    Lie {
+        /// Step (s).
+        dt: f64,
+    },
+    /// Composition of the exact torque-free flow with the flow of the torques and effectors:
+    /// Strang (order 2) or the order-4 triple jump, fixed step.
+    Splitting {
+        /// Step (s).
+        dt: f64,
+        /// Order: 2 or 4.
+        order: u8,
     },
     /// Closed-form torque-free solution.
     Exact,
 }
 
 impl Method {
-    /// Names accepted in YAML and on the command line.
-    pub const NAMES: [&'static str; 3] = ["rk4", "dopri5", "exact"];
+    /// Names accepted in YAML and on the command line (`auto` picks one of the others).
+    pub const NAMES: [&'static str; 9] = [
+        "rk4",
+        "dopri5",
+        "dop853",
+        "radau5",
+        "gauss",
+        "lie",
+        "splitting",
+        "exact",
+        "auto",
+    ];
 
     /// Its name.
     pub fn name(&self) -> &'static str {
         match self {
             Method::Rk4 { .. } => "rk4",
-            Method::Dopri5 { .. } => "dopri5",
+            Method::Dopri5(_) => "dopri5",
+            Method::Dop853(_) => "dop853",
+            Method::Radau5(_) => "radau5",
+            Method::Gauss { .. } => "gauss",
+            Method::Lie { .. } => "lie",
+            Method::Splitting { .. } => "splitting",
             Method::Exact => "exact",
         }
     }
@@ -330,20 +392,40 @@ impl Method {
     pub fn describe(&self) -> String {
         match self {
             Method::Rk4 { dt } => format!("rk4 (dt {dt:e} s)"),
-            Method::Dopri5 {
-                rtol,
-                atol,
-                max_step,
-            } => {
-                let cap = if max_step.is_finite() {
-                    format!(", max_step {max_step:e} s")
-                } else {
-                    String::new()
-                };
-                format!("dopri5 (rtol {rtol:e}, atol {atol:e}{cap})")
+            Method::Dopri5(a) => format!("dopri5 ({})", a.describe()),
+            Method::Dop853(a) => format!("dop853 ({})", a.describe()),
+            Method::Radau5(a) => format!("radau5 ({})", a.describe()),
+            Method::Gauss { dt, stages } => {
+                format!("gauss ({stages} stage(s), order {}, dt {dt:e} s)", 2 * stages)
             }
+            Method::Lie { dt } => format!("lie (RKMK4, dt {dt:e} s)"),
+            Method::Splitting { dt, order } => format!("splitting (order {order}, dt {dt:e} s)"),
             Method::Exact => "exact (closed-form torque-free solution)".into(),
         }
+    }
+
+    /// The fixed step (s) of a fixed-step method.
+    pub fn fixed_step(&self) -> Option<f64> {
+        match *self {
+            Method::Rk4 { dt }
+            | Method::Gauss { dt, .. }
+            | Method::Lie { dt }
+            | Method::Splitting { dt, .. } => Some(dt),
+            _ => None,
+        }
+    }
+
+    /// The settings of an adaptive method.
+    pub fn adaptive(&self) -> Option<Adaptive> {
+        match *self {
+            Method::Dopri5(a) | Method::Dop853(a) | Method::Radau5(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// Whether the method is implicit (A-stable: no step-size limit from stiffness).
+    pub fn is_implicit(&self) -> bool {
+        matches!(self, Method::Radau5(_) | Method::Gauss { .. })
     }
 }
 
@@ -391,6 +473,8 @@ pub struct Scenario {
     pub duration: f64,
     /// Integration method.
     pub method: Method,
+    /// Why `auto` picked [`Scenario::method`] (None when the method was named).
+    pub method_choice: Option<String>,
     /// Samples per second of sim time (Hz).
     pub output_rate: f64,
     /// Where the MCAP log goes.
@@ -418,6 +502,10 @@ pub struct Overrides {
     pub rtol: Option<f64>,
     /// `--atol`.
     pub atol: Option<f64>,
+    /// `--stages` (gauss).
+    pub stages: Option<u32>,
+    /// `--order` (splitting).
+    pub order: Option<u32>,
     /// `--duration` (s).
     pub duration: Option<f64>,
     /// `--out`.
@@ -729,7 +817,7 @@ impl ScenarioFile {
                 None => Ok(None),
                 Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
                 Some(x) => {
-                    let (l, f) = from(v, s.as_ref().and_then(loc), field, flag);
+                    let (l, f) = from(v.map(f64::from), s.as_ref().and_then(loc), field, flag);
                     Err(err(
                         l,
                         f,
@@ -760,34 +848,91 @@ impl ScenarioFile {
             "integrator.max_step",
             "step in seconds",
         )?;
+        let (method_field, method_l) = if ov.method.is_some() {
+            ("--method", None)
+        } else {
+            ("integrator.method", method_loc)
+        };
+        let need_dt = |name: &str| {
+            dt.ok_or_else(|| {
+                err(
+                    method_l,
+                    "integrator.dt",
+                    format!("{name} has a fixed step: expected `dt: <seconds>` (or --dt)"),
+                )
+            })
+        };
+        let adaptive = Adaptive {
+            rtol: rtol.unwrap_or(1e-10),
+            atol: atol.unwrap_or(1e-12),
+            max_step: max_step.unwrap_or(f64::INFINITY),
+        };
+        let choice = |v: Option<u32>,
+                      s: &Option<Spanned<u32>>,
+                      field: &'static str,
+                      flag: &'static str,
+                      allowed: [u32; 2],
+                      default: u32| {
+            let x = v.or(s.as_ref().map(|x| x.value)).unwrap_or(default);
+            if allowed.contains(&x) {
+                Ok(x as u8)
+            } else {
+                let (l, f) = from(v.map(f64::from), s.as_ref().and_then(loc), field, flag);
+                Err(err(
+                    l,
+                    f,
+                    format!("expected {} or {}, got {x}", allowed[0], allowed[1]),
+                ))
+            }
+        };
+        let stages = choice(
+            ov.stages,
+            &spec.stages,
+            "integrator.stages",
+            "--stages",
+            [1, 2],
+            2,
+        )?;
+        let order = choice(
+            ov.order,
+            &spec.order,
+            "integrator.order",
+            "--order",
+            [2, 4],
+            4,
+        )?;
+        let mut auto = false;
         let method = match method_name.as_str() {
             "rk4" => Method::Rk4 {
-                dt: dt.ok_or_else(|| {
-                    err(
-                        method_loc,
-                        "integrator.dt",
-                        "rk4 needs a step: expected `dt: <seconds>` (or --dt)".into(),
-                    )
-                })?,
+                dt: need_dt("rk4")?,
             },
-            "dopri5" => Method::Dopri5 {
-                rtol: rtol.unwrap_or(1e-10),
-                atol: atol.unwrap_or(1e-12),
-                max_step: max_step.unwrap_or(f64::INFINITY),
+            "dopri5" => Method::Dopri5(adaptive),
+            "dop853" => Method::Dop853(adaptive),
+            "radau5" => Method::Radau5(adaptive),
+            "gauss" => Method::Gauss {
+                dt: need_dt("gauss")?,
+                stages,
+            },
+            "lie" => Method::Lie {
+                dt: need_dt("lie")?,
+            },
+            "splitting" => Method::Splitting {
+                dt: need_dt("splitting")?,
+                order,
             },
             "exact" => Method::Exact,
+            "auto" => {
+                // Resolved once the spacecraft is built; dop853 stands in for the checks.
+                auto = true;
+                Method::Dop853(adaptive)
+            }
             other => {
                 let hint = nearest(other, Method::NAMES)
                     .map(|b| format!("; did you mean `{b}`?"))
                     .unwrap_or_default();
-                let (l, f) = if ov.method.is_some() {
-                    (None, "--method")
-                } else {
-                    (method_loc, "integrator.method")
-                };
                 return Err(err(
-                    l,
-                    f,
+                    method_l,
+                    method_field,
                     format!(
                         "unknown method `{other}`, expected one of {}{hint}",
                         Method::NAMES.join(", ")
@@ -795,7 +940,7 @@ impl ScenarioFile {
                 ));
             }
         };
-        if let Method::Rk4 { dt } = method
+        if let Some(dt) = method.fixed_step()
             && duration / dt > 1e11
         {
             let (l, f) = if ov.dt.is_some() || ov.duration.is_some() {
@@ -814,9 +959,8 @@ impl ScenarioFile {
         }
         // Bound the work a valid-looking file can ask for.
         let max_steps = match method {
-            Method::Dopri5 { max_step, .. } => duration / max_step,
             Method::Exact => duration * output_rate_hint(&self.output).max(4.0 * omega0.norm()),
-            Method::Rk4 { .. } => 0.0,
+            m => m.adaptive().map_or(0.0, |a| duration / a.max_step),
         };
         if max_steps > 1e11 {
             let (l, f) = match (&spec.max_step, ov.duration) {
@@ -833,7 +977,7 @@ impl ScenarioFile {
                 ),
             ));
         }
-        if let Method::Dopri5 { rtol, .. } = method
+        if let Some(Adaptive { rtol, .. }) = method.adaptive()
             && rtol < 1e-15
         {
             let (l, f) = from(
@@ -987,19 +1131,31 @@ impl ScenarioFile {
             }
             spacecraft.set_motion(Box::new(motion));
         }
-        if matches!(method, Method::Exact) && !spacecraft.effectors().is_empty() {
+        let free_rigid = spacecraft.effectors().is_empty() && spacecraft.motion().is_none();
+        if matches!(method, Method::Exact) && !free_rigid {
             return Err(err(
-                method_loc,
-                if ov.method.is_some() {
-                    "--method"
-                } else {
-                    "integrator.method"
-                },
+                method_l,
+                method_field,
                 "method `exact` solves the torque-free rigid body only, and this spacecraft \
-                 has effectors; use dopri5 or rk4"
+                 has effectors or a prescribed motion; use dop853, dopri5 or auto"
                     .into(),
             ));
         }
+        if matches!(method, Method::Splitting { .. }) && spacecraft.motion().is_some() {
+            return Err(err(
+                method_l,
+                method_field,
+                "method `splitting` composes the free rigid-body flow with the rest, and the \
+                 hub's rotation here is prescribed (`hub_motion`); use dop853 or auto"
+                    .into(),
+            ));
+        }
+        let (method, method_choice) = if auto {
+            let (m, why) = choose_method(&spacecraft, &omega0, &attitude0, duration, adaptive);
+            (m, Some(why))
+        } else {
+            (method, None)
+        };
 
         Ok(Scenario {
             path: path.to_path_buf(),
@@ -1012,6 +1168,7 @@ impl ScenarioFile {
             attitude0,
             duration,
             method,
+            method_choice,
             output_rate,
             mcap_path,
             scene_rate,
@@ -1020,6 +1177,55 @@ impl ScenarioFile {
             events,
             shape,
         })
+    }
+}
+
+/// Stiffness ratio above which `auto` picks the implicit method: an explicit method's stable
+/// step would be a thousandth of the motion's time scale.
+pub const AUTO_STIFFNESS_RATIO: f64 = 1e3;
+
+/// What `auto` runs: `exact` for a torque-free rigid body; otherwise `radau5` when the
+/// equations are stiff at the initial state (see [`crate::linearize::Stiffness::ratio`]),
+/// else `dop853`. Returns the method and the reason, printed with the run.
+pub fn choose_method(
+    sc: &Spacecraft,
+    omega0: &Vector3<f64>,
+    attitude0: &UnitQuaternion<f64>,
+    duration: f64,
+    adaptive: Adaptive,
+) -> (Method, String) {
+    if sc.effectors().is_empty() && sc.motion().is_none() {
+        return (
+            Method::Exact,
+            "auto: torque-free rigid body, so the closed-form solution (no truncation error)"
+                .into(),
+        );
+    }
+    let y0 = sc.initial_state(omega0, attitude0);
+    let st = crate::linearize::stiffness(sc, 0.0, &y0, duration);
+    if st.ratio() > AUTO_STIFFNESS_RATIO {
+        (
+            Method::Radau5(adaptive),
+            format!(
+                "auto: stiff (fastest eigenvalue |λ| = {:.3e} 1/s is {:.1e} times the motion's \
+                 rate {:.3e} 1/s, above {AUTO_STIFFNESS_RATIO:e}), so radau5 (L-stable implicit)",
+                st.spectral_radius,
+                st.ratio(),
+                st.motion_rate
+            ),
+        )
+    } else {
+        (
+            Method::Dop853(adaptive),
+            format!(
+                "auto: not stiff (fastest eigenvalue |λ| = {:.3e} 1/s is {:.1e} times the \
+                 motion's rate {:.3e} 1/s, below {AUTO_STIFFNESS_RATIO:e}), so dop853 (explicit, \
+                 order 8)",
+                st.spectral_radius,
+                st.ratio(),
+                st.motion_rate
+            ),
+        )
     }
 }
 

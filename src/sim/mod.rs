@@ -5,11 +5,14 @@
 //! sign changes of `Condition::margin`, bracketed at step ends (and at interior points) and
 //! located by the Illinois variant of regula falsi on the dense output.
 
-use crate::exact::TorqueFreeSolution;
-use crate::integrate::{Dopri5, OdeSystem, Rk4, Stats, StepError, Stepper, Tolerances};
+mod methods;
+
+pub use methods::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
+
+use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
 use crate::scenario::{Condition, Method, Scenario};
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -171,135 +174,73 @@ pub struct Outcome {
 pub fn run(scenario: &Scenario, sink: &mut dyn Sink, ctl: Control) -> std::io::Result<Outcome> {
     let sc = &scenario.spacecraft;
     let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
-    match scenario.method {
-        Method::Rk4 { dt } => drive(Rk4::new(0.0, &y0, dt), scenario, sink, ctl, 0),
-        Method::Dopri5 {
-            rtol,
-            atol,
-            max_step,
-        } => {
-            let tol = Tolerances { rtol, atol };
-            drive(
-                Dopri5::new(0.0, &y0, tol, max_step, None),
-                scenario,
-                sink,
-                ctl,
-                3,
-            )
+    match AnyStepper::for_scenario(scenario, &y0) {
+        Ok(stepper) => {
+            let interior_checks = if scenario.method.fixed_step().is_some() {
+                0
+            } else {
+                3
+            };
+            drive(stepper, scenario, sink, ctl, interior_checks)
         }
-        Method::Exact => match ExactStepper::new(sc, &y0, scenario.output_rate) {
-            Ok(stepper) => drive(stepper, scenario, sink, ctl, 3),
-            Err(diagnosis) => {
-                let o = sc.observe(0.0, &y0);
-                Ok(Outcome {
-                    status: Status::Failed { diagnosis },
-                    final_observation: o.clone(),
-                    initial_observation: o,
-                    final_state: y0,
-                    stats: Stats::default(),
-                    drift: Drift::default(),
-                    events: vec![],
-                    samples: 0,
-                    wall_time: 0.0,
-                })
-            }
-        },
+        Err(diagnosis) => {
+            let o = sc.observe(0.0, &y0);
+            Ok(Outcome {
+                status: Status::Failed { diagnosis },
+                final_observation: o.clone(),
+                initial_observation: o,
+                final_state: y0,
+                stats: Stats::default(),
+                drift: Drift::default(),
+                events: vec![],
+                samples: 0,
+                wall_time: 0.0,
+            })
+        }
     }
 }
 
-/// The closed-form torque-free solution as a [`Stepper`]: steps are evaluation points
-/// (at most a fraction of a polhode period apart, so events are bracketed), and
-/// interpolation is exact.
-pub struct ExactStepper {
-    solution: TorqueFreeSolution,
-    h: f64,
-    t: f64,
-    t_prev: f64,
-    y: Vec<f64>,
-    stats: Stats,
+/// What [`integrate_only`] measured.
+#[derive(Debug, Clone)]
+pub struct Solve {
+    /// State at the end.
+    pub final_state: Vec<f64>,
+    /// Work counters.
+    pub stats: Stats,
+    /// CPU (wall-clock, single thread) time of the integration alone (s).
+    pub seconds: f64,
 }
 
-impl ExactStepper {
-    /// Refuses spacecraft with effectors: the closed form is for the torque-free rigid body.
-    pub fn new(sc: &Spacecraft, y0: &[f64], output_rate: f64) -> Result<Self, String> {
-        if !sc.effectors().is_empty() {
-            return Err(
-                "method `exact` solves the torque-free rigid body only, and this \
-                        spacecraft has effectors; use dopri5 or rk4"
-                    .into(),
+/// Integrates `scenario` from 0 to `t_end` (s) with its method and nothing else: no output
+/// samples, events, invariant tracking or logging. The cost of the method alone, for
+/// benchmarks (`polhode bench`). `Err` is a diagnosis.
+pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> {
+    let sc = &scenario.spacecraft;
+    let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
+    let started = Instant::now();
+    let mut stepper = AnyStepper::for_scenario(scenario, &y0)?;
+    while stepper.t() < t_end {
+        let t0 = stepper.t();
+        stepper
+            .step(sc, t_end)
+            .map_err(|e| diagnose(&e.to_string(), t0, stepper.y(), scenario))?;
+        if !stepper.y().iter().all(|v| v.is_finite()) {
+            let what = format!(
+                "the state became non-finite in the step from t = {} s to t = {} s",
+                stepper.t_prev(),
+                stepper.t()
             );
+            let mut buf = vec![0.0; y0.len()];
+            stepper.interpolate(stepper.t_prev(), &mut buf);
+            return Err(diagnose(&what, stepper.t_prev(), &buf, scenario));
         }
-        let omega0 = Vector3::new(y0[0], y0[1], y0[2]);
-        let q0 =
-            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y0[3], y0[4], y0[5], y0[6]));
-        let solution = TorqueFreeSolution::new(&sc.hub.inertia, &omega0, &q0)
-            .map_err(|e| format!("the exact solution is not available: {e}"))?;
-        let period = solution.polhode_period();
-        // Rotation rate bounds how fast anything observable can change.
-        let spin = omega0.norm().max(1e-300);
-        let mut h = (1.0 / output_rate).min(0.25 / spin);
-        if period.is_finite() && period > 0.0 {
-            h = h.min(period / 32.0);
-        }
-        Ok(ExactStepper {
-            solution,
-            h,
-            t: 0.0,
-            t_prev: 0.0,
-            y: y0.to_vec(),
-            stats: Stats::default(),
-        })
     }
-
-    fn evaluate(&self, t: f64, out: &mut [f64], reference: &[f64]) {
-        let (w, q) = self.solution.state_at(t);
-        // Keep the quaternion on the same hemisphere as the reference, for smooth telemetry.
-        let s = if q.w * reference[3] + q.i * reference[4] + q.j * reference[5] + q.k * reference[6]
-            < 0.0
-        {
-            -1.0
-        } else {
-            1.0
-        };
-        out[..3].copy_from_slice(w.as_slice());
-        out[3] = s * q.w;
-        out[4] = s * q.i;
-        out[5] = s * q.j;
-        out[6] = s * q.k;
-    }
-}
-
-impl Stepper for ExactStepper {
-    fn t(&self) -> f64 {
-        self.t
-    }
-    fn y(&self) -> &[f64] {
-        &self.y
-    }
-    fn t_prev(&self) -> f64 {
-        self.t_prev
-    }
-    fn stats(&self) -> Stats {
-        self.stats
-    }
-    fn step<S: OdeSystem + ?Sized>(&mut self, _sys: &S, t_end: f64) -> Result<f64, StepError> {
-        let t1 = if t_end - self.t <= self.h * (1.0 + 1e-9) {
-            t_end
-        } else {
-            self.t + self.h
-        };
-        // Evaluate into a stack buffer (the hemisphere reference is the current state).
-        let mut y = [0.0; 7];
-        self.evaluate(t1, &mut y, &self.y);
-        self.y.copy_from_slice(&y);
-        self.t_prev = self.t;
-        self.t = t1;
-        self.stats.steps += 1;
-        Ok(t1)
-    }
-    fn interpolate(&self, t: f64, out: &mut [f64]) {
-        self.evaluate(t, out, &self.y);
-    }
+    let seconds = started.elapsed().as_secs_f64();
+    Ok(Solve {
+        final_state: stepper.y().to_vec(),
+        stats: stepper.stats(),
+        seconds,
+    })
 }
 
 /// How often (in steps) the interrupt flag and the wall clock are looked at.
@@ -575,23 +516,77 @@ fn locate<M: Stepper>(
     b
 }
 
-/// A diagnosis for a failed integration: what, when, the state, and what to try.
-fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
+/// Where an explicit method's stability region meets the negative real axis, in units of
+/// h·|λ| (classical RK4: 2.785, Hairer, Nørsett & Wanner, *Solving ODEs I*, §IV.2; the
+/// splitting's RK4 sub-steps take γ·h/2, hence the larger bounds).
+fn stability_bound(m: &Method) -> Option<f64> {
+    const RK4: f64 = 2.785;
+    match m {
+        Method::Rk4 { .. } | Method::Lie { .. } => Some(RK4),
+        Method::Splitting { order: 2, .. } => Some(2.0 * RK4),
+        Method::Splitting { .. } => Some(2.0 * RK4 * (2.0 - 2f64.cbrt())),
+        Method::Dopri5(_) => Some(3.3),
+        Method::Dop853(_) => Some(6.0),
+        _ => None,
+    }
+}
+
+/// A diagnosis for a failed integration: what, when, the state, the suspected cause and what
+/// to try.
+pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
     let state: Vec<String> = y.iter().take(7).map(|v| format!("{v:.6e}")).collect();
-    // `t` and `y` are the last finite state known.
-    let remedy = match scenario.method {
-        Method::Rk4 { dt } => format!(
-            "the fixed step dt = {dt:e} s may exceed the stability limit of rk4 for this \
-             scene: reduce dt, or use dopri5"
+    // `t` and `y` are the last finite state known: how stiff are the equations there?
+    let sc = &scenario.spacecraft;
+    let stiffness = y
+        .iter()
+        .all(|v| v.is_finite())
+        .then(|| crate::linearize::stiffness(sc, t, y, scenario.duration));
+    let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
+    let m = &scenario.method;
+    let (cause, remedy) = match (m.fixed_step(), stability_bound(m)) {
+        (Some(h), Some(bound)) if rho.is_finite() && h * rho > 0.8 * bound => (
+            format!(
+                "numerical instability: the fastest eigenvalue of the equations has \
+                 |λ| = {rho:.4e} 1/s, so h·|λ| = {:.3} is beyond {}'s stability bound ≈ \
+                 {bound:.2} (largest stable step ≈ {:.3e} s)",
+                h * rho,
+                m.name(),
+                bound / rho
+            ),
+            format!(
+                "reduce dt below {:.3e} s, or use an implicit method: radau5 (adaptive) or \
+                 gauss (fixed step, A-stable)",
+                0.8 * bound / rho
+            ),
         ),
-        Method::Dopri5 { .. } => "check the model parameters for a singularity (e.g. a \
-                                  vanishing inertia); loosen rtol/atol if the tolerance \
-                                  cannot be met"
-            .into(),
-        Method::Exact => "report this as a bug with the scenario attached".into(),
+        (Some(h), _) => (
+            format!(
+                "the fixed step dt = {h:e} s is too coarse for this scene (fastest |λ| = \
+                 {rho:.4e} 1/s)"
+            ),
+            "reduce dt, or use an adaptive method (dop853, or radau5 when stiff)".into(),
+        ),
+        (None, _) if matches!(m, Method::Exact) => (
+            "the closed-form solution failed".into(),
+            "report this as a bug with the scenario attached".into(),
+        ),
+        (None, _) if !m.is_implicit() && stiffness.is_some_and(|s| s.ratio() > 1e3) => (
+            format!(
+                "stiffness: the fastest eigenvalue |λ| = {rho:.4e} 1/s is {:.1e} times the \
+                 motion's rate, so an explicit method crawls at its stability limit",
+                stiffness.map_or(f64::NAN, |s| s.ratio())
+            ),
+            "use radau5 (or auto, which picks it for stiff scenes)".into(),
+        ),
+        (None, _) => (
+            "a singularity of the model, or a tolerance that cannot be met".into(),
+            "check the model parameters (e.g. a vanishing inertia or mass); loosen rtol/atol"
+                .into(),
+        ),
     };
     format!(
-        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suspected cause: {cause}; \
+         suggested remedy: {remedy}",
         state.join(", ")
     )
 }
