@@ -110,13 +110,40 @@ enum BenchCommand {
         /// Simulated duration (s), overrides `duration`.
         #[arg(long)]
         duration: Option<f64>,
-        /// Number of timed solves; the fastest is reported.
+        /// Number of timed solves; the fastest is reported (0: as many as fit in 0.3 s, ≤ 7).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+    },
+    /// Error against CPU time for every method on a problem set (charts and CSV).
+    WorkPrecision {
+        /// Problems (comma-separated; default all: generic-tumble, near-separatrix,
+        /// tennis-racket, damper, explorer1-pydy).
+        #[arg(long, value_delimiter = ',')]
+        problems: Vec<String>,
+        #[command(flatten)]
+        sweep: SweepArgs,
     },
 }
 
 /// Method options shared by `run` and `bench point`.
+#[derive(clap::Args, Debug, Clone)]
+struct SweepArgs {
+    /// Methods to include (comma-separated labels; default all).
+    #[arg(long, value_delimiter = ',')]
+    methods: Vec<String>,
+    /// Directory for the charts (SVG and PNG) and CSV.
+    #[arg(long, default_value = "docs/figures")]
+    out: PathBuf,
+    /// A method's sweep stops after the first solve slower than this (s).
+    #[arg(long, default_value_t = 1.0)]
+    budget: f64,
+    /// Most settings tried per method.
+    #[arg(long, default_value_t = 10)]
+    max_points: usize,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct MethodArgs {
     /// Integration method: rk4, dopri5, dop853, radau5, gauss, lie, splitting, exact or auto.
@@ -219,6 +246,96 @@ fn bench_cmd(what: BenchCommand) -> i32 {
                     EXIT_FAILED
                 }
             }
+        }
+        BenchCommand::WorkPrecision { problems, sweep } => {
+            use crate::bench::work_precision::{PROBLEMS, Problem};
+            let chosen: Vec<Problem> = if problems.is_empty() {
+                PROBLEMS.to_vec()
+            } else {
+                let mut v = Vec::new();
+                for name in &problems {
+                    match PROBLEMS.iter().find(|p| p.name == name) {
+                        Some(p) => v.push(*p),
+                        None => {
+                            let names: Vec<&str> = PROBLEMS.iter().map(|p| p.name).collect();
+                            eprintln!(
+                                "error: --problems: unknown problem `{name}`, expected some of {}",
+                                names.join(", ")
+                            );
+                            return EXIT_BAD_INPUT;
+                        }
+                    }
+                }
+                v
+            };
+            let methods = match methods_named(&sweep.methods) {
+                Ok(m) => m,
+                Err(code) => return code,
+            };
+            if let Err(e) = std::fs::create_dir_all(&sweep.out) {
+                eprintln!("error: {}: {e}", sweep.out.display());
+                return EXIT_IO;
+            }
+            let budget = crate::bench::Budget {
+                seconds_per_point: sweep.budget,
+                max_points: sweep.max_points,
+            };
+            report_files(
+                crate::bench::work_precision::run(
+                    Path::new("."),
+                    &chosen,
+                    &methods,
+                    &budget,
+                    &sweep.out,
+                    bench_progress(sweep.quiet),
+                ),
+                sweep.quiet,
+            )
+        }
+    }
+}
+
+/// The methods named in `labels` (all when empty), or exit code 2 for an unknown one.
+fn methods_named(labels: &[String]) -> Result<Vec<crate::bench::MethodSpec>, i32> {
+    use crate::bench::{METHODS, MethodSpec};
+    if labels.is_empty() {
+        return Ok(METHODS.to_vec());
+    }
+    labels
+        .iter()
+        .map(|l| {
+            MethodSpec::by_label(l).ok_or_else(|| {
+                eprintln!(
+                    "error: --methods: unknown method `{l}`, expected some of {}",
+                    MethodSpec::labels().join(", ")
+                );
+                EXIT_BAD_INPUT
+            })
+        })
+        .collect()
+}
+
+fn bench_progress(quiet: bool) -> impl FnMut(&str) {
+    move |line: &str| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    }
+}
+
+fn report_files(result: Result<Vec<PathBuf>, String>, quiet: bool) -> i32 {
+    match result {
+        Ok(files) => {
+            if !quiet {
+                for f in files {
+                    println!("wrote {}", f.display());
+                }
+            }
+            0
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_FAILED
         }
     }
 }

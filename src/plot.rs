@@ -1323,6 +1323,34 @@ fn count_hits(style: Style, pieces: &[Vec<(f64, f64)>], rect: &Rect) -> usize {
     n
 }
 
+/// Renders an SVG document (as written by [`Chart::to_svg`]) to a PNG file at twice its
+/// size, on white, with the system's fonts (DejaVu Sans for `sans-serif` when present).
+pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
+    use resvg::{tiny_skia, usvg};
+    let mut options = usvg::Options::default();
+    {
+        let db = options.fontdb_mut();
+        db.load_system_fonts();
+        if db.faces().any(|f| f.families.iter().any(|(n, _)| n == "DejaVu Sans")) {
+            db.set_sans_serif_family("DejaVu Sans");
+        }
+    }
+    let tree = usvg::Tree::from_str(svg, &options).map_err(|e| format!("SVG: {e}"))?;
+    let scale = 2.0;
+    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty chart")?;
+    let mut pixmap =
+        tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("chart too large")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(
+        &tree,
+        tiny_skia::Transform::from_scale(scale, scale),
+        &mut pixmap.as_mut(),
+    );
+    pixmap
+        .save_png(path)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,9 +6,137 @@
 //! output sampling), measured in this process: the machines are shared and noisy, and the
 //! minimum is the least disturbed estimate of the method's cost.
 
+pub mod work_precision;
+
 use crate::integrate::Stats;
-use crate::scenario::Scenario;
+use crate::plot::Chart;
+use crate::scenario::{self, Overrides, Scenario};
 use crate::sim::{self, Solve};
+use std::path::{Path, PathBuf};
+
+/// A method as the benchmarks run it: a scenario method name plus its variant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodSpec {
+    /// Label in charts and tables (e.g. `gauss-2`, `splitting-4`).
+    pub label: &'static str,
+    /// Method name in scenarios.
+    pub name: &'static str,
+    /// `stages` (gauss).
+    pub stages: Option<u32>,
+    /// `order` (splitting).
+    pub order: Option<u32>,
+    /// The accuracy knob is the step `dt`.
+    pub fixed_step: bool,
+    /// The accuracy knob is the tolerance `rtol` (with `atol = 1e-3·rtol`).
+    pub adaptive: bool,
+}
+
+const fn fixed(label: &'static str, name: &'static str) -> MethodSpec {
+    MethodSpec {
+        label,
+        name,
+        stages: None,
+        order: None,
+        fixed_step: true,
+        adaptive: false,
+    }
+}
+
+const fn adaptive(label: &'static str) -> MethodSpec {
+    MethodSpec {
+        label,
+        name: label,
+        stages: None,
+        order: None,
+        fixed_step: false,
+        adaptive: true,
+    }
+}
+
+/// Every method with its variants, in chart order.
+pub const METHODS: [MethodSpec; 10] = [
+    fixed("rk4", "rk4"),
+    adaptive("dopri5"),
+    adaptive("dop853"),
+    adaptive("radau5"),
+    MethodSpec {
+        stages: Some(1),
+        ..fixed("gauss-1", "gauss")
+    },
+    MethodSpec {
+        stages: Some(2),
+        ..fixed("gauss-2", "gauss")
+    },
+    fixed("lie", "lie"),
+    MethodSpec {
+        order: Some(2),
+        ..fixed("splitting-2", "splitting")
+    },
+    MethodSpec {
+        order: Some(4),
+        ..fixed("splitting-4", "splitting")
+    },
+    MethodSpec {
+        label: "exact",
+        name: "exact",
+        stages: None,
+        order: None,
+        fixed_step: false,
+        adaptive: false,
+    },
+];
+
+impl MethodSpec {
+    /// The method labelled `label`.
+    pub fn by_label(label: &str) -> Option<MethodSpec> {
+        METHODS.iter().find(|m| m.label == label).copied()
+    }
+
+    /// Labels of all methods.
+    pub fn labels() -> Vec<&'static str> {
+        METHODS.iter().map(|m| m.label).collect()
+    }
+}
+
+/// Limits of a sweep.
+#[derive(Debug, Clone, Copy)]
+pub struct Budget {
+    /// A method's sweep stops after the first solve slower than this (s).
+    pub seconds_per_point: f64,
+    /// Most settings tried per method.
+    pub max_points: usize,
+}
+
+/// Loads `path` with `method` at accuracy `knob` (dt, or rtol with atol = 1e-3·rtol) and
+/// `duration` (s).
+pub fn load_with(
+    path: &Path,
+    method: &MethodSpec,
+    knob: Option<f64>,
+    duration: Option<f64>,
+) -> Result<Scenario, String> {
+    let overrides = Overrides {
+        method: Some(method.name.into()),
+        dt: knob.filter(|_| method.fixed_step),
+        rtol: knob.filter(|_| method.adaptive),
+        atol: knob.filter(|_| method.adaptive).map(|r| 1e-3 * r),
+        stages: method.stages,
+        order: method.order,
+        duration,
+        mcap: None,
+    };
+    scenario::load(path, &overrides).map_err(|e| e.to_string())
+}
+
+/// Writes `chart` as `<stem>.svg` and `<stem>.png` (900×600 px); returns both paths.
+pub fn svg_and_png(chart: &Chart, stem: &Path) -> Result<Vec<PathBuf>, String> {
+    let svg = chart.to_svg(900, 600);
+    let svg_path = stem.with_extension("svg");
+    let png_path = stem.with_extension("png");
+    std::fs::write(&svg_path, &svg).map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    crate::plot::write_png(&svg, &png_path)?;
+    Ok(vec![svg_path, png_path])
+}
 
 /// One timed solve of a scenario with its method.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -42,10 +170,20 @@ pub struct Point {
 }
 
 /// Solves `scenario` over its duration `repeats` times (at least once) and keeps the fastest.
+/// `repeats = 0` adapts the count to the cost: up to 7 solves while they total under 0.3 s,
+/// so that quick solves are not timed from a single noisy sample.
 pub fn point(scenario: &Scenario, repeats: usize) -> Result<Point, String> {
     let mut best: Option<Solve> = None;
-    let mut all = Vec::new();
-    for _ in 0..repeats.max(1) {
+    let mut all: Vec<f64> = Vec::new();
+    for k in 0.. {
+        let done = if repeats == 0 {
+            k >= 7 || (k >= 1 && all.iter().sum::<f64>() > 0.3)
+        } else {
+            k >= repeats.max(1)
+        };
+        if done {
+            break;
+        }
         let s = sim::integrate_only(scenario, scenario.duration)?;
         all.push(s.seconds);
         if best.as_ref().is_none_or(|b| s.seconds < b.seconds) {

@@ -6,15 +6,19 @@
 //! (fixed-step, adaptive, implicit, a closed-form propagator) only has to provide these few
 //! operations.
 
+mod dop853;
 mod dopri5;
 mod gauss;
+mod radau5;
 pub mod jacobian;
 mod rk4;
 #[cfg(test)]
 mod test_systems;
 
+pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use gauss::{Gauss, GaussStages};
+pub use radau5::Radau5;
 pub use rk4::Rk4;
 
 use std::fmt;

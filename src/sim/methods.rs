@@ -11,7 +11,7 @@
 
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{
-    Dopri5, Gauss, GaussStages, OdeSystem, Rk4, Stats, StepError, Stepper, Tolerances,
+    Dop853, Dopri5, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError, Stepper, Tolerances,
 };
 use crate::model::Spacecraft;
 use crate::scenario::{Method, Scenario};
@@ -24,6 +24,10 @@ pub enum AnyStepper {
     Rk4(Rk4),
     /// Dormand–Prince 5(4).
     Dopri5(Dopri5),
+    /// Dormand–Prince 8(5,3).
+    Dop853(Dop853),
+    /// Radau IIA order 5.
+    Radau5(Radau5),
     /// Gauss–Legendre collocation.
     Gauss(Gauss),
     /// RKMK4 on the attitude.
@@ -36,8 +40,10 @@ pub enum AnyStepper {
 
 impl AnyStepper {
     /// The stepper for `scenario`'s method, starting at `(0, y0)`; `Err` (a diagnosis) when
-    /// the method cannot treat this spacecraft.
-    pub fn for_scenario(scenario: &Scenario, y0: &[f64]) -> Result<Self, String> {
+    /// the method cannot treat this spacecraft. Without `dense_output`, a method may skip
+    /// the work that only interpolation needs (dop853's three extra stages), and then
+    /// `interpolate` is valid at the step's ends only.
+    pub fn for_scenario(scenario: &Scenario, y0: &[f64], dense_output: bool) -> Result<Self, String> {
         let sc = &scenario.spacecraft;
         let tol = |a: crate::scenario::Adaptive| {
             (
@@ -62,8 +68,13 @@ impl AnyStepper {
                 };
                 AnyStepper::Gauss(Gauss::new(0.0, y0, dt, stages))
             }
-            Method::Dop853(_) | Method::Radau5(_) => {
-                return Err("PENDING".into());
+            Method::Radau5(a) => {
+                let (t, m) = tol(a);
+                AnyStepper::Radau5(Radau5::new(0.0, y0, t, m, None))
+            }
+            Method::Dop853(a) => {
+                let (t, m) = tol(a);
+                AnyStepper::Dop853(Dop853::new(0.0, y0, t, m, None).with_dense_output(dense_output))
             }
             Method::Lie { dt } => AnyStepper::Lie(LieStepper::new(0.0, y0, dt)),
             Method::Splitting { dt, order } => {
@@ -79,6 +90,8 @@ macro_rules! each {
         match $self {
             AnyStepper::Rk4($s) => $e,
             AnyStepper::Dopri5($s) => $e,
+            AnyStepper::Dop853($s) => $e,
+            AnyStepper::Radau5($s) => $e,
             AnyStepper::Gauss($s) => $e,
             AnyStepper::Lie($s) => $e,
             AnyStepper::Splitting($s) => $e,

@@ -174,7 +174,7 @@ pub struct Outcome {
 pub fn run(scenario: &Scenario, sink: &mut dyn Sink, ctl: Control) -> std::io::Result<Outcome> {
     let sc = &scenario.spacecraft;
     let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
-    match AnyStepper::for_scenario(scenario, &y0) {
+    match AnyStepper::for_scenario(scenario, &y0, true) {
         Ok(stepper) => {
             let interior_checks = if scenario.method.fixed_step().is_some() {
                 0
@@ -218,7 +218,7 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
     let sc = &scenario.spacecraft;
     let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
     let started = Instant::now();
-    let mut stepper = AnyStepper::for_scenario(scenario, &y0)?;
+    let mut stepper = AnyStepper::for_scenario(scenario, &y0, false)?;
     while stepper.t() < t_end {
         let t0 = stepper.t();
         stepper
@@ -230,6 +230,7 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
                 stepper.t_prev(),
                 stepper.t()
             );
+            // Without dense output only the step's ends can be read: report the start.
             let mut buf = vec![0.0; y0.len()];
             stepper.interpolate(stepper.t_prev(), &mut buf);
             return Err(diagnose(&what, stepper.t_prev(), &buf, scenario));

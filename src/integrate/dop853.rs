@@ -1,0 +1,1165 @@
+//! Dormand–Prince 8(5,3) ("DOP853") with Hairer's step-size control and seventh-order dense
+//! output.
+//!
+//! The method: twelve stages give an eighth-order solution; the local error is estimated from
+//! an embedded fifth-order and an embedded third-order solution, combined as
+//! `err = err₅² / √(err₅² + 0.01·err₃²)`, which is of order eight for small steps but does
+//! not collapse when the fifth-order estimate happens to vanish. The stage evaluated at the
+//! new point (number 13) is the first stage of the next step (FSAL). Three more stages
+//! (14–16) give a continuous extension of order seven.
+//!
+//! Sources: P. J. Prince & J. R. Dormand, "High order embedded Runge–Kutta formulae",
+//! J. Comput. Appl. Math. 7 (1981); Hairer, Nørsett & Wanner, *Solving Ordinary Differential
+//! Equations I* (2nd ed., Springer 1993), §II.10 (the method, its coefficients and its
+//! error estimate) and §II.6 (dense output); the decimal coefficient values are those of
+//! Hairer & Wanner's published Fortran code `dop853.f` (the same values SciPy transcribes in
+//! `scipy/integrate/_ivp/dop853_coefficients.py`), written out below with all their digits.
+//! The starting step is that code's `HINIT` with order 8,
+//! with root-mean-square norms as in the error estimate.
+//!
+//! Right-hand-side evaluations: 11 per attempted step (stages 2–12), plus 1 for stage 13 at
+//! the new point when the step is accepted (reused as stage 1 of the next step), plus 3 for
+//! the dense-output stages of an accepted step (unless switched off with
+//! [`Dop853::with_dense_output`]); the first step adds 1 for `f(t0, y0)` and, without a given
+//! first step, 1 for the starting-step estimate. So a run costs
+//! `1 [+ 1] + 15·accepted + 11·rejected` evaluations (12 instead of 15 without dense output).
+
+// The coefficients keep all the digits of the published tables so that they can be checked
+// against the source by eye; the compiler rounds them to the nearest `f64`.
+#![allow(clippy::excessive_precision)]
+
+use super::{OdeSystem, Stats, StepError, Stepper, Tolerances};
+
+// Nodes (c₁ = 0, c₁₂ = c₁₃ = 1).
+const C2: f64 = 0.526001519587677318785587544488e-01;
+const C3: f64 = 0.789002279381515978178381316732e-01;
+const C4: f64 = 0.118350341907227396726757197510e+00;
+const C5: f64 = 0.281649658092772603273242802490e+00;
+const C6: f64 = 0.333333333333333333333333333333e+00;
+const C7: f64 = 0.25e+00;
+const C8: f64 = 0.307692307692307692307692307692e+00;
+const C9: f64 = 0.651282051282051282051282051282e+00;
+const C10: f64 = 0.6e+00;
+const C11: f64 = 0.857142857142857142857142857142e+00;
+const C14: f64 = 0.1e+00;
+const C15: f64 = 0.2e+00;
+const C16: f64 = 0.777777777777777777777777777778e+00;
+
+// Stage matrix, `A{i}_{j}` = a_ij (stage i uses stage j); zero entries are left out.
+const A2_1: f64 = 5.26001519587677318785587544488e-2;
+const A3_1: f64 = 1.97250569845378994544595329183e-2;
+const A3_2: f64 = 5.91751709536136983633785987549e-2;
+const A4_1: f64 = 2.95875854768068491816892993775e-2;
+const A4_3: f64 = 8.87627564304205475450678981324e-2;
+const A5_1: f64 = 2.41365134159266685502369798665e-1;
+const A5_3: f64 = -8.84549479328286085344864962717e-1;
+const A5_4: f64 = 9.24834003261792003115737966543e-1;
+const A6_1: f64 = 3.7037037037037037037037037037e-2;
+const A6_4: f64 = 1.70828608729473871279604482173e-1;
+const A6_5: f64 = 1.25467687566822425016691814123e-1;
+const A7_1: f64 = 3.7109375e-2;
+const A7_4: f64 = 1.70252211019544039314978060272e-1;
+const A7_5: f64 = 6.02165389804559606850219397283e-2;
+const A7_6: f64 = -1.7578125e-2;
+const A8_1: f64 = 3.70920001185047927108779319836e-2;
+const A8_4: f64 = 1.70383925712239993810214054705e-1;
+const A8_5: f64 = 1.07262030446373284651809199168e-1;
+const A8_6: f64 = -1.53194377486244017527936158236e-2;
+const A8_7: f64 = 8.27378916381402288758473766002e-3;
+const A9_1: f64 = 6.24110958716075717114429577812e-1;
+const A9_4: f64 = -3.36089262944694129406857109825e0;
+const A9_5: f64 = -8.68219346841726006818189891453e-1;
+const A9_6: f64 = 2.75920996994467083049415600797e1;
+const A9_7: f64 = 2.01540675504778934086186788979e1;
+const A9_8: f64 = -4.34898841810699588477366255144e1;
+const A10_1: f64 = 4.77662536438264365890433908527e-1;
+const A10_4: f64 = -2.48811461997166764192642586468e0;
+const A10_5: f64 = -5.90290826836842996371446475743e-1;
+const A10_6: f64 = 2.12300514481811942347288949897e1;
+const A10_7: f64 = 1.52792336328824235832596922938e1;
+const A10_8: f64 = -3.32882109689848629194453265587e1;
+const A10_9: f64 = -2.03312017085086261358222928593e-2;
+const A11_1: f64 = -9.3714243008598732571704021658e-1;
+const A11_4: f64 = 5.18637242884406370830023853209e0;
+const A11_5: f64 = 1.09143734899672957818500254654e0;
+const A11_6: f64 = -8.14978701074692612513997267357e0;
+const A11_7: f64 = -1.85200656599969598641566180701e1;
+const A11_8: f64 = 2.27394870993505042818970056734e1;
+const A11_9: f64 = 2.49360555267965238987089396762e0;
+const A11_10: f64 = -3.0467644718982195003823669022e0;
+const A12_1: f64 = 2.27331014751653820792359768449e0;
+const A12_4: f64 = -1.05344954667372501984066689879e1;
+const A12_5: f64 = -2.00087205822486249909675718444e0;
+const A12_6: f64 = -1.79589318631187989172765950534e1;
+const A12_7: f64 = 2.79488845294199600508499808837e1;
+const A12_8: f64 = -2.85899827713502369474065508674e0;
+const A12_9: f64 = -8.87285693353062954433549289258e0;
+const A12_10: f64 = 1.23605671757943030647266201528e1;
+const A12_11: f64 = 6.43392746015763530355970484046e-1;
+
+// Weights of the eighth-order solution (stages 1, 6–12); also row 13 of the stage matrix.
+const B1: f64 = 5.42937341165687622380535766363e-2;
+const B6: f64 = 4.45031289275240888144113950566e0;
+const B7: f64 = 1.89151789931450038304281599044e0;
+const B8: f64 = -5.8012039600105847814672114227e0;
+const B9: f64 = 3.1116436695781989440891606237e-1;
+const B10: f64 = -1.52160949662516078556178806805e-1;
+const B11: f64 = 2.01365400804030348374776537501e-1;
+const B12: f64 = 4.47106157277725905176885569043e-2;
+
+// Third-order embedded weights (stages 1, 9, 12): err₃ = Σ b·k − (BHH1 k₁ + BHH2 k₉ + BHH3 k₁₂).
+const BHH1: f64 = 0.244094488188976377952755905512e+00;
+const BHH2: f64 = 0.733846688281611857341361741547e+00;
+const BHH3: f64 = 0.220588235294117647058823529412e-01;
+
+// Fifth-order error weights (stages 1, 6–12): err₅ = Σ ER·k.
+const ER1: f64 = 0.1312004499419488073250102996e-01;
+const ER6: f64 = -0.1225156446376204440720569753e+01;
+const ER7: f64 = -0.4957589496572501915214079952e+00;
+const ER8: f64 = 0.1664377182454986536961530415e+01;
+const ER9: f64 = -0.3503288487499736816886487290e+00;
+const ER10: f64 = 0.3341791187130174790297318841e+00;
+const ER11: f64 = 0.8192320648511571246570742613e-01;
+const ER12: f64 = -0.2235530786388629525884427845e-01;
+
+// Dense-output stages 14–16.
+const A14_1: f64 = 5.61675022830479523392909219681e-2;
+const A14_7: f64 = 2.53500210216624811088794765333e-1;
+const A14_8: f64 = -2.46239037470802489917441475441e-1;
+const A14_9: f64 = -1.24191423263816360469010140626e-1;
+const A14_10: f64 = 1.5329179827876569731206322685e-1;
+const A14_11: f64 = 8.20105229563468988491666602057e-3;
+const A14_12: f64 = 7.56789766054569976138603589584e-3;
+const A14_13: f64 = -8.298e-3;
+const A15_1: f64 = 3.18346481635021405060768473261e-2;
+const A15_6: f64 = 2.83009096723667755288322961402e-2;
+const A15_7: f64 = 5.35419883074385676223797384372e-2;
+const A15_8: f64 = -5.49237485713909884646569340306e-2;
+const A15_11: f64 = -1.08347328697249322858509316994e-4;
+const A15_12: f64 = 3.82571090835658412954920192323e-4;
+const A15_13: f64 = -3.40465008687404560802977114492e-4;
+const A15_14: f64 = 1.41312443674632500278074618366e-1;
+const A16_1: f64 = -4.28896301583791923408573538692e-1;
+const A16_6: f64 = -4.69762141536116384314449447206e0;
+const A16_7: f64 = 7.68342119606259904184240953878e0;
+const A16_8: f64 = 4.06898981839711007970213554331e0;
+const A16_9: f64 = 3.56727187455281109270669543021e-1;
+const A16_13: f64 = -1.39902416515901462129418009734e-3;
+const A16_14: f64 = 2.9475147891527723389556272149e0;
+const A16_15: f64 = -9.15095847217987001081870187138e0;
+
+// Dense-output coefficients d₄…d₇ (Hairer's d41…d716), each over stages
+// 1, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16 in that order.
+const D4: [f64; 12] = [
+    -0.84289382761090128651353491142e+01,
+    0.56671495351937776962531783590e+00,
+    -0.30689499459498916912797304727e+01,
+    0.23846676565120698287728149680e+01,
+    0.21170345824450282767155149946e+01,
+    -0.87139158377797299206789907490e+00,
+    0.22404374302607882758541771650e+01,
+    0.63157877876946881815570249290e+00,
+    -0.88990336451333310820698117400e-01,
+    0.18148505520854727256656404962e+02,
+    -0.91946323924783554000451984436e+01,
+    -0.44360363875948939664310572000e+01,
+];
+const D5: [f64; 12] = [
+    0.10427508642579134603413151009e+02,
+    0.24228349177525818288430175319e+03,
+    0.16520045171727028198505394887e+03,
+    -0.37454675472269020279518312152e+03,
+    -0.22113666853125306036270938578e+02,
+    0.77334326684722638389603898808e+01,
+    -0.30674084731089398182061213626e+02,
+    -0.93321305264302278729567221706e+01,
+    0.15697238121770843886131091075e+02,
+    -0.31139403219565177677282850411e+02,
+    -0.93529243588444783865713862664e+01,
+    0.35816841486394083752465898540e+02,
+];
+const D6: [f64; 12] = [
+    0.19985053242002433820987653617e+02,
+    -0.38703730874935176555105901742e+03,
+    -0.18917813819516756882830838328e+03,
+    0.52780815920542364900561016686e+03,
+    -0.11573902539959630126141871134e+02,
+    0.68812326946963000169666922661e+01,
+    -0.10006050966910838403183860980e+01,
+    0.77771377980534432092869265740e+00,
+    -0.27782057523535084065932004339e+01,
+    -0.60196695231264120758267380846e+02,
+    0.84320405506677161018159903784e+02,
+    0.11992291136182789328035130030e+02,
+];
+const D7: [f64; 12] = [
+    -0.25693933462703749003312586129e+02,
+    -0.15418974869023643374053993627e+03,
+    -0.23152937917604549567536039109e+03,
+    0.35763911791061412378285349910e+03,
+    0.93405324183624310003907691704e+02,
+    -0.37458323136451633156875139351e+02,
+    0.10409964950896230045147246184e+03,
+    0.29840293426660503123344363579e+02,
+    -0.43533456590011143754432175058e+02,
+    0.96324553959188282948394950600e+02,
+    -0.39177261675615439165231486172e+02,
+    -0.14972683625798562581422125276e+03,
+];
+
+// Step-size control, with the defaults of dop853.f.
+const SAFETY: f64 = 0.9;
+const FAC_MIN: f64 = 0.333; // the step shrinks by at most 1/0.333 ≈ 3×
+const FAC_MAX: f64 = 6.0; // and grows by at most 6×
+/// PI-control stabilisation; 0 (Hairer's default for DOP853) makes it the classical
+/// controller `h·(1/err)^{1/8}`. The code keeps the PI form so the term can be tuned.
+const BETA: f64 = 0.0;
+const EXPO: f64 = 1.0 / 8.0 - 0.2 * BETA;
+const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
+
+/// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument). The slices are cut to `out.len()` first
+/// so the loops carry no bounds checks; the `M` terms are unrolled; the increments are summed
+/// before they are added to `base`, as in the textbook formula.
+#[inline(always)]
+fn combine<const M: usize>(out: &mut [f64], base: &[f64], h: f64, a: [f64; M], mut k: [&[f64]; M]) {
+    let n = out.len();
+    for kj in k.iter_mut() {
+        *kj = &kj[..n];
+    }
+    for (i, o) in out.iter_mut().enumerate() {
+        let mut acc = a[0] * k[0][i];
+        for j in 1..M {
+            acc += a[j] * k[j][i];
+        }
+        *o = h * acc;
+    }
+    for (o, &b) in out.iter_mut().zip(&base[..n]) {
+        *o += b;
+    }
+}
+
+/// Adaptive Dormand–Prince 8(5,3) ("DOP853", the method of SciPy's `DOP853` and of Hairer's
+/// `dop853.f`): eighth order, for smooth problems at tight tolerances, where it needs far
+/// fewer right-hand-side evaluations than [`super::Dopri5`].
+///
+/// Integrates forward in time only (`t_end > t`).
+///
+/// Dense output is computed eagerly on every accepted step (3 extra evaluations, 15 per step
+/// in all). It cannot be lazy: [`Stepper::interpolate`] is given no system to evaluate, and a
+/// stepper cannot keep a borrow of the system between calls. A caller that never interpolates
+/// inside steps can switch it off with [`Dop853::with_dense_output`] (12 per step).
+#[derive(Debug, Clone)]
+pub struct Dop853 {
+    tol: Tolerances,
+    h_max: f64,
+    t: f64,
+    t_prev: f64,
+    h: f64,
+    y: Vec<f64>,
+    /// Candidate state at the end of the step being tried.
+    y_new: Vec<f64>,
+    /// Argument of the stage being evaluated.
+    stage: Vec<f64>,
+    /// Stages 1–16 (`k[0]` = f(t, y), kept across steps by FSAL).
+    k: [Vec<f64>; 16],
+    /// Dense-output coefficients of the last accepted step; `cont[0]` is the state at its
+    /// start (kept even without dense output).
+    cont: [Vec<f64>; 8],
+    dense: bool,
+    fac_old: f64,
+    first_step: bool,
+    stats: Stats,
+}
+
+impl Dop853 {
+    /// Starts at `(t0, y0)` (t in s). `h_max` (s) caps the step (use `f64::INFINITY` for
+    /// none); `h0` is the first step (s), or `None` to choose it automatically.
+    pub fn new(t0: f64, y0: &[f64], tol: Tolerances, h_max: f64, h0: Option<f64>) -> Self {
+        let n = y0.len();
+        let z = || vec![0.0; n];
+        Dop853 {
+            tol,
+            h_max,
+            t: t0,
+            t_prev: t0,
+            h: h0.unwrap_or(0.0),
+            y: y0.to_vec(),
+            y_new: z(),
+            stage: z(),
+            k: std::array::from_fn(|_| z()),
+            cont: std::array::from_fn(|_| y0.to_vec()),
+            dense: true,
+            fac_old: 1e-4,
+            first_step: true,
+            stats: Stats::default(),
+        }
+    }
+
+    /// Turns the seventh-order dense output on (the default) or off. Off saves the 3
+    /// extra right-hand-side evaluations of each accepted step (a fifth of the cost), for
+    /// callers that only need the states at the step ends; [`Stepper::interpolate`] then
+    /// panics for a time strictly inside a step.
+    pub fn with_dense_output(mut self, enabled: bool) -> Self {
+        self.dense = enabled;
+        self
+    }
+
+    /// Step size the controller proposes next (s).
+    pub fn proposed_step(&self) -> f64 {
+        self.h
+    }
+
+    /// Starting step by Hairer's `HINIT` (order 8), with RMS norms; `k[0]` holds f(t, y).
+    /// Costs one right-hand-side evaluation.
+    fn initial_step<S: OdeSystem + ?Sized>(&mut self, sys: &S, span: f64) -> f64 {
+        let n = self.y.len();
+        let sc = |y: f64| self.tol.atol + self.tol.rtol * y.abs();
+        let (mut dny, mut dnf) = (0.0, 0.0);
+        for (&y, &f) in self.y.iter().zip(&self.k[0]) {
+            dny += (y / sc(y)).powi(2);
+            dnf += (f / sc(y)).powi(2);
+        }
+        let (dny, dnf) = ((dny / n as f64).sqrt(), (dnf / n as f64).sqrt());
+        let mut h = if dny < 1e-10 || dnf < 1e-10 {
+            1e-6
+        } else {
+            0.01 * dny / dnf
+        };
+        h = h.min(self.h_max).min(span);
+        combine(&mut self.stage, &self.y, h, [1.0], [&self.k[0]]);
+        sys.rhs(self.t + h, &self.stage, &mut self.k[1]);
+        self.stats.rhs_evaluations += 1;
+        let mut der2 = 0.0;
+        for i in 0..n {
+            der2 += ((self.k[1][i] - self.k[0][i]) / sc(self.y[i])).powi(2);
+        }
+        let der12 = ((der2 / n as f64).sqrt() / h).max(dnf);
+        let h1 = if der12 <= 1e-15 {
+            (h * 1e-3).max(1e-6)
+        } else {
+            (0.01 / der12).powf(1.0 / 8.0)
+        };
+        let h = (100.0 * h).min(h1).min(self.h_max).min(span);
+        // Scaled norms can overflow (tiny atol, huge states): fall back to a small step and
+        // let the controller find its way from there.
+        if h.is_finite() && h > 0.0 {
+            h
+        } else {
+            (1e-6 * span).min(self.h_max)
+        }
+    }
+
+    /// Evaluates stages 2–12 for step `h` from `(t, y)` with `k[0] = f(t, y)`, writes the
+    /// eighth-order solution to `y_new`, and returns the scaled error estimate of the step
+    /// (≤ 1 to accept; non-finite if the stages were).
+    fn attempt<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> f64 {
+        let t = self.t;
+        let n = self.y.len();
+        let (y, s, k) = (&self.y[..], &mut self.stage[..], &mut self.k);
+        combine(s, y, h, [A2_1], [&k[0]]);
+        sys.rhs(t + C2 * h, s, &mut k[1]);
+        combine(s, y, h, [A3_1, A3_2], [&k[0], &k[1]]);
+        sys.rhs(t + C3 * h, s, &mut k[2]);
+        combine(s, y, h, [A4_1, A4_3], [&k[0], &k[2]]);
+        sys.rhs(t + C4 * h, s, &mut k[3]);
+        combine(s, y, h, [A5_1, A5_3, A5_4], [&k[0], &k[2], &k[3]]);
+        sys.rhs(t + C5 * h, s, &mut k[4]);
+        combine(s, y, h, [A6_1, A6_4, A6_5], [&k[0], &k[3], &k[4]]);
+        sys.rhs(t + C6 * h, s, &mut k[5]);
+        combine(
+            s,
+            y,
+            h,
+            [A7_1, A7_4, A7_5, A7_6],
+            [&k[0], &k[3], &k[4], &k[5]],
+        );
+        sys.rhs(t + C7 * h, s, &mut k[6]);
+        combine(
+            s,
+            y,
+            h,
+            [A8_1, A8_4, A8_5, A8_6, A8_7],
+            [&k[0], &k[3], &k[4], &k[5], &k[6]],
+        );
+        sys.rhs(t + C8 * h, s, &mut k[7]);
+        combine(
+            s,
+            y,
+            h,
+            [A9_1, A9_4, A9_5, A9_6, A9_7, A9_8],
+            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7]],
+        );
+        sys.rhs(t + C9 * h, s, &mut k[8]);
+        combine(
+            s,
+            y,
+            h,
+            [A10_1, A10_4, A10_5, A10_6, A10_7, A10_8, A10_9],
+            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8]],
+        );
+        sys.rhs(t + C10 * h, s, &mut k[9]);
+        combine(
+            s,
+            y,
+            h,
+            [A11_1, A11_4, A11_5, A11_6, A11_7, A11_8, A11_9, A11_10],
+            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8], &k[9]],
+        );
+        sys.rhs(t + C11 * h, s, &mut k[10]);
+        combine(
+            s,
+            y,
+            h,
+            [
+                A12_1, A12_4, A12_5, A12_6, A12_7, A12_8, A12_9, A12_10, A12_11,
+            ],
+            [
+                &k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10],
+            ],
+        );
+        sys.rhs(t + h, s, &mut k[11]);
+        self.stats.rhs_evaluations += 11;
+
+        // New state and both error estimates in one pass.
+        let (k1, k6, k7, k8) = (&k[0][..n], &k[5][..n], &k[6][..n], &k[7][..n]);
+        let (k9, k10, k11, k12) = (&k[8][..n], &k[9][..n], &k[10][..n], &k[11][..n]);
+        let y_new = &mut self.y_new[..n];
+        let (atol, rtol) = (self.tol.atol, self.tol.rtol);
+        let (mut err5, mut err3) = (0.0, 0.0);
+        for i in 0..n {
+            let slope = B1 * k1[i]
+                + B6 * k6[i]
+                + B7 * k7[i]
+                + B8 * k8[i]
+                + B9 * k9[i]
+                + B10 * k10[i]
+                + B11 * k11[i]
+                + B12 * k12[i];
+            y_new[i] = y[i] + h * slope;
+            let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
+            let e3 = slope - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
+            let e5 = ER1 * k1[i]
+                + ER6 * k6[i]
+                + ER7 * k7[i]
+                + ER8 * k8[i]
+                + ER9 * k9[i]
+                + ER10 * k10[i]
+                + ER11 * k11[i]
+                + ER12 * k12[i];
+            err3 += (e3 / sk).powi(2);
+            err5 += (e5 / sk).powi(2);
+        }
+        // h·err₅²/√(err₅² + 0.01·err₃²) with RMS norms (Hairer, §II.10).
+        let mut deno = err5 + 0.01 * err3;
+        if deno <= 0.0 {
+            deno = 1.0;
+        }
+        h.abs() * err5 / (n as f64 * deno).sqrt()
+    }
+
+    /// For a step that passed the error test: evaluates stage 13 = f(t + h, y_new) (the next
+    /// step's first stage) and, with dense output on, stages 14–16. Returns whether all
+    /// were finite (if not, the step is rejected as having left the model's domain).
+    fn end_stages<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64, t_new: f64) -> bool {
+        let all_finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        sys.rhs(t_new, &self.y_new, &mut self.k[12]);
+        self.stats.rhs_evaluations += 1;
+        if !all_finite(&self.k[12]) {
+            return false;
+        }
+        if !self.dense {
+            return true;
+        }
+        let (t, y, s, k) = (self.t, &self.y[..], &mut self.stage[..], &mut self.k);
+        combine(
+            s,
+            y,
+            h,
+            [A14_1, A14_7, A14_8, A14_9, A14_10, A14_11, A14_12, A14_13],
+            [&k[0], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11], &k[12]],
+        );
+        sys.rhs(t + C14 * h, s, &mut k[13]);
+        combine(
+            s,
+            y,
+            h,
+            [A15_1, A15_6, A15_7, A15_8, A15_11, A15_12, A15_13, A15_14],
+            [&k[0], &k[5], &k[6], &k[7], &k[10], &k[11], &k[12], &k[13]],
+        );
+        sys.rhs(t + C15 * h, s, &mut k[14]);
+        combine(
+            s,
+            y,
+            h,
+            [A16_1, A16_6, A16_7, A16_8, A16_9, A16_13, A16_14, A16_15],
+            [&k[0], &k[5], &k[6], &k[7], &k[8], &k[12], &k[13], &k[14]],
+        );
+        sys.rhs(t + C16 * h, s, &mut k[15]);
+        self.stats.rhs_evaluations += 3;
+        k[13..16].iter().all(|v| all_finite(v))
+    }
+
+    /// Fills `cont` for the accepted step `h` from `y` to `y_new` (before they are swapped).
+    fn store_dense_output(&mut self, h: f64) {
+        let n = self.y.len();
+        let (y, y_new, k) = (&self.y[..n], &self.y_new[..n], &self.k);
+        let [c0, c1, c2, c3, c4, c5, c6, c7] = &mut self.cont;
+        let (k1, k13) = (&k[0][..n], &k[12][..n]);
+        let (c0, c1, c2, c3) = (&mut c0[..n], &mut c1[..n], &mut c2[..n], &mut c3[..n]);
+        for i in 0..n {
+            let dy = y_new[i] - y[i];
+            let bspl = h * k1[i] - dy;
+            c0[i] = y[i];
+            c1[i] = dy;
+            c2[i] = bspl;
+            c3[i] = dy - h * k13[i] - bspl;
+        }
+        // Stages 1, 6–16, in the order of the rows D4…D7. One pass for the four rows, so
+        // each stage value is loaded once.
+        let ks: [&[f64]; 12] = [
+            &k[0][..n],
+            &k[5][..n],
+            &k[6][..n],
+            &k[7][..n],
+            &k[8][..n],
+            &k[9][..n],
+            &k[10][..n],
+            &k[11][..n],
+            &k[12][..n],
+            &k[13][..n],
+            &k[14][..n],
+            &k[15][..n],
+        ];
+        let (c4, c5, c6, c7) = (&mut c4[..n], &mut c5[..n], &mut c6[..n], &mut c7[..n]);
+        for i in 0..n {
+            let (mut s4, mut s5, mut s6, mut s7) = (0.0, 0.0, 0.0, 0.0);
+            for j in 0..12 {
+                let v = ks[j][i];
+                s4 += D4[j] * v;
+                s5 += D5[j] * v;
+                s6 += D6[j] * v;
+                s7 += D7[j] * v;
+            }
+            c4[i] = h * s4;
+            c5[i] = h * s5;
+            c6[i] = h * s6;
+            c7[i] = h * s7;
+        }
+    }
+}
+
+impl Stepper for Dop853 {
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+
+    fn t_prev(&self) -> f64 {
+        self.t_prev
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError> {
+        let span = t_end - self.t;
+        if self.first_step {
+            sys.rhs(self.t, &self.y, &mut self.k[0]);
+            self.stats.rhs_evaluations += 1;
+            if !self.k[0].iter().all(|v| v.is_finite()) {
+                return Err(StepError::NonFiniteDerivative { t: self.t });
+            }
+            if self.h <= 0.0 {
+                self.h = self.initial_step(sys, span);
+            }
+            self.first_step = false;
+        }
+        let mut rejected_in_a_row = 0;
+        let mut saw_non_finite = false;
+        loop {
+            let h_wanted = self.h.min(self.h_max);
+            // Land exactly on t_end rather than leave a sliver of a step.
+            let last = h_wanted >= span * (1.0 - 1e-12);
+            let t_new = if last { t_end } else { self.t + h_wanted };
+            // The step is the difference of the two times, so steps add up to the times exactly.
+            let h = t_new - self.t;
+            if h.abs() <= 16.0 * f64::EPSILON * self.t.abs().max(1e-300) {
+                return Err(if saw_non_finite {
+                    StepError::NonFiniteDerivative { t: self.t }
+                } else {
+                    StepError::StepSizeUnderflow { t: self.t, h }
+                });
+            }
+            let err = self.attempt(sys, h);
+            // Stage 13 (and the dense stages) only for a step that passes the error test.
+            let finite = err.is_finite() && (err > 1.0 || self.end_stages(sys, h, t_new));
+            if !finite {
+                saw_non_finite = true;
+                self.stats.rejected_steps += 1;
+                self.h = 0.1 * h;
+                rejected_in_a_row += 1;
+                if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
+                    return Err(StepError::NonFiniteDerivative { t: self.t });
+                }
+                continue;
+            }
+            // err^(1/8) by square roots when BETA = 0: a fraction of the cost of `powf`.
+            let fac11 = if BETA == 0.0 {
+                err.sqrt().sqrt().sqrt()
+            } else {
+                err.powf(EXPO)
+            };
+            if err <= 1.0 {
+                // Accepted: (PI) controller for the next step.
+                let mut fac = if BETA == 0.0 {
+                    fac11
+                } else {
+                    fac11 / self.fac_old.powf(BETA)
+                };
+                fac = (fac / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                let mut h_new = h / fac;
+                if rejected_in_a_row > 0 {
+                    h_new = h_new.min(h);
+                }
+                self.fac_old = err.max(1e-4);
+                if self.dense {
+                    self.store_dense_output(h);
+                } else {
+                    self.cont[0].copy_from_slice(&self.y);
+                }
+                std::mem::swap(&mut self.y, &mut self.y_new);
+                // FSAL: stage 13 is f at the new point.
+                self.k.swap(0, 12);
+                self.t_prev = self.t;
+                self.t = t_new;
+                self.stats.steps += 1;
+                // Keep the proposal for the next call; a shortened last step does not shrink it.
+                self.h = if last { self.h.max(h_new) } else { h_new };
+                return Ok(self.t);
+            }
+            self.stats.rejected_steps += 1;
+            rejected_in_a_row += 1;
+            if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
+                return Err(StepError::StepSizeUnderflow { t: self.t, h });
+            }
+            self.h = h / (1.0 / FAC_MIN).min(fac11 / SAFETY);
+        }
+    }
+
+    /// Seventh-order interpolant of the last accepted step. Panics for a time strictly inside
+    /// the step if dense output was switched off ([`Dop853::with_dense_output`]).
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let h = self.t - self.t_prev;
+        // The step's ends are returned as stored.
+        if h == 0.0 || t == self.t {
+            out.copy_from_slice(&self.y);
+            return;
+        }
+        if t == self.t_prev {
+            out.copy_from_slice(&self.cont[0]);
+            return;
+        }
+        assert!(
+            self.dense,
+            "Dop853::interpolate inside a step needs dense output, which was switched off"
+        );
+        let s = (t - self.t_prev) / h;
+        let s1 = 1.0 - s;
+        let n = out.len();
+        let [c0, c1, c2, c3, c4, c5, c6, c7] = &self.cont;
+        let (c0, c1, c2, c3) = (&c0[..n], &c1[..n], &c2[..n], &c3[..n]);
+        let (c4, c5, c6, c7) = (&c4[..n], &c5[..n], &c6[..n], &c7[..n]);
+        for i in 0..n {
+            let conpar = c4[i] + s * (c5[i] + s1 * (c6[i] + s * c7[i]));
+            out[i] = c0[i] + s * (c1[i] + s1 * (c2[i] + s * (c3[i] + s1 * conpar)));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::Dopri5;
+    use crate::integrate::test_systems::{
+        Clock, Counted, Exponential, Kepler, Oscillator, EulerBody, kepler_exact,
+    };
+    use std::f64::consts::PI;
+
+    /// Tolerances so loose that every step is accepted: with `h0 = h_max = h` the step is fixed.
+    const FIXED: Tolerances = Tolerances {
+        rtol: 1e6,
+        atol: 1e6,
+    };
+
+    fn tol(t: f64) -> Tolerances {
+        Tolerances { rtol: t, atol: t }
+    }
+
+    fn run<S: OdeSystem>(s: &mut Dop853, sys: &S, t_end: f64) {
+        while s.t() < t_end {
+            s.step(sys, t_end).unwrap();
+        }
+        assert_eq!(s.t(), t_end);
+    }
+
+    fn dist(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+
+    fn sci(pts: &[(f64, f64)]) -> String {
+        let v: Vec<String> = pts
+            .iter()
+            .map(|(h, e)| format!("({h:.3}, {e:.2e})"))
+            .collect();
+        v.join(" ")
+    }
+
+    fn sci1(v: &[f64]) -> String {
+        let v: Vec<String> = v.iter().map(|e| format!("{e:.2e}")).collect();
+        v.join(" ")
+    }
+
+    /// Least-squares slope of log(err) against log(h).
+    fn slope(points: &[(f64, f64)]) -> f64 {
+        let m = points.len() as f64;
+        let (xs, ys): (Vec<f64>, Vec<f64>) = points.iter().map(|&(h, e)| (h.ln(), e.ln())).unzip();
+        let (mx, my) = (xs.iter().sum::<f64>() / m, ys.iter().sum::<f64>() / m);
+        let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+        let sxx: f64 = xs.iter().map(|x| (x - mx).powi(2)).sum();
+        sxy / sxx
+    }
+
+    #[test]
+    fn coefficients_satisfy_the_simplest_order_conditions() {
+        // Catches a mistyped coefficient: every row sums to its node, the weights integrate
+        // polynomials of degree < 8 exactly, the error weights annihilate constants.
+        let rows: [(f64, &[f64]); 15] = [
+            (C2, &[A2_1]),
+            (C3, &[A3_1, A3_2]),
+            (C4, &[A4_1, A4_3]),
+            (C5, &[A5_1, A5_3, A5_4]),
+            (C6, &[A6_1, A6_4, A6_5]),
+            (C7, &[A7_1, A7_4, A7_5, A7_6]),
+            (C8, &[A8_1, A8_4, A8_5, A8_6, A8_7]),
+            (C9, &[A9_1, A9_4, A9_5, A9_6, A9_7, A9_8]),
+            (C10, &[A10_1, A10_4, A10_5, A10_6, A10_7, A10_8, A10_9]),
+            (
+                C11,
+                &[A11_1, A11_4, A11_5, A11_6, A11_7, A11_8, A11_9, A11_10],
+            ),
+            (
+                1.0,
+                &[
+                    A12_1, A12_4, A12_5, A12_6, A12_7, A12_8, A12_9, A12_10, A12_11,
+                ],
+            ),
+            (1.0, &[B1, B6, B7, B8, B9, B10, B11, B12]),
+            (
+                C14,
+                &[A14_1, A14_7, A14_8, A14_9, A14_10, A14_11, A14_12, A14_13],
+            ),
+            (
+                C15,
+                &[A15_1, A15_6, A15_7, A15_8, A15_11, A15_12, A15_13, A15_14],
+            ),
+            (
+                C16,
+                &[A16_1, A16_6, A16_7, A16_8, A16_9, A16_13, A16_14, A16_15],
+            ),
+        ];
+        for (i, (c, row)) in rows.iter().enumerate() {
+            let sum: f64 = row.iter().sum();
+            assert!((sum - c).abs() < 1e-14, "row {}: {sum} vs {c}", i + 2);
+        }
+        let b = [B1, B6, B7, B8, B9, B10, B11, B12];
+        let c = [0.0, C6, C7, C8, C9, C10, C11, 1.0];
+        for q in 1..=8 {
+            let quad: f64 = b.iter().zip(&c).map(|(b, c)| b * c.powi(q - 1)).sum();
+            assert!((quad - 1.0 / q as f64).abs() < 1e-13, "q = {q}: {quad}");
+        }
+        let er = [ER1, ER6, ER7, ER8, ER9, ER10, ER11, ER12];
+        assert!(er.iter().sum::<f64>().abs() < 1e-14);
+        assert!((BHH1 + BHH2 + BHH3 - 1.0).abs() < 1e-14);
+    }
+
+    /// Kepler orbit (e = 0.5) over one period with `steps` fixed steps, from mean anomaly
+    /// 1 rad: error at the end.
+    ///
+    /// Not from periapsis: the error contributions of the two halves of a periapsis passage
+    /// split across the ends then nearly cancel, and the slope approaches 8 only below the
+    /// roundoff floor (7.1 measured over the same range of steps).
+    fn kepler_fixed_step_error(steps: u32) -> f64 {
+        let (e, t0, period) = (0.5, 1.0, 2.0 * PI);
+        let h = period / steps as f64;
+        let mut s = Dop853::new(t0, &kepler_exact(e, t0), FIXED, h, Some(h));
+        run(&mut s, &Kepler, t0 + period);
+        assert_eq!(s.stats().steps, steps as u64);
+        assert_eq!(s.stats().rejected_steps, 0);
+        dist(s.y(), &kepler_exact(e, t0 + period))
+    }
+
+    #[test]
+    fn convergence_order_is_eight_on_the_kepler_orbit() {
+        let pts: Vec<(f64, f64)> = [40, 50, 60, 80, 100, 130, 160]
+            .iter()
+            .map(|&n| (2.0 * PI / n as f64, kepler_fixed_step_error(n)))
+            .collect();
+        let p = slope(&pts);
+        println!("Kepler fixed-step (h, error): {}; slope {p:.3}", sci(&pts));
+        assert!(pts.iter().all(|&(_, e)| e > 1e-12), "errors near roundoff");
+        assert!((p - 8.0).abs() < 0.3, "measured order {p}");
+    }
+
+    #[test]
+    fn convergence_order_is_eight_on_euler_rigid_body() {
+        // A tumble about the intermediate axis, against a Dopri5 reference at rtol 1e-13
+        // (which agrees with one at 1e-12 to ~1e-11, so errors are kept above 1e-11).
+        let (w0, t_end) = ([0.3, 1.0, 0.4], 20.0);
+        let mut r = Dopri5::new(0.0, &w0, tol(1e-13), f64::INFINITY, None);
+        while r.t() < t_end {
+            r.step(&EulerBody([1.0, 2.0, 3.0]), t_end).unwrap();
+        }
+        let reference = r.y().to_vec();
+        let pts: Vec<(f64, f64)> = [30, 40, 50, 64, 80]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut s = Dop853::new(0.0, &w0, FIXED, h, Some(h));
+                run(&mut s, &EulerBody([1.0, 2.0, 3.0]), t_end);
+                assert_eq!(s.stats().steps, n);
+                (h, dist(s.y(), &reference))
+            })
+            .collect();
+        let p = slope(&pts);
+        println!(
+            "rigid body fixed-step (h, error): {}; slope {p:.3}",
+            sci(&pts)
+        );
+        assert!(
+            pts.iter().all(|&(_, e)| e > 1e-11),
+            "errors near the reference's"
+        );
+        assert!((p - 8.0).abs() < 0.3, "measured order {p}");
+    }
+
+    #[test]
+    fn one_step_errors_are_of_order_nine_at_the_end_and_eight_inside() {
+        // One step of size h from the exact state just before periapsis (where the orbit is
+        // fastest): the local error of the step is O(h⁹), the interpolant's worst error
+        // inside the step O(h⁸).
+        let (e, t0) = (0.5, -0.1);
+        let (mut inside, mut end) = (vec![], vec![]);
+        for h in [0.2, 0.15, 0.1, 0.07, 0.05, 0.035] {
+            let mut s = Dop853::new(t0, &kepler_exact(e, t0), FIXED, h, Some(h));
+            s.step(&Kepler, t0 + h).unwrap();
+            let mut out = [0.0; 4];
+            let mut worst: f64 = 0.0;
+            for j in 1..20 {
+                let t = t0 + h * j as f64 / 20.0;
+                s.interpolate(t, &mut out);
+                worst = worst.max(dist(&out, &kepler_exact(e, t)));
+            }
+            inside.push((h, worst));
+            end.push((h, dist(s.y(), &kepler_exact(e, t0 + h))));
+        }
+        end.pop(); // 4e-14: too close to roundoff
+        let (pi, pe) = (slope(&inside), slope(&end));
+        println!(
+            "dense output (h, worst error): {}; slope {pi:.3}",
+            sci(&inside)
+        );
+        println!("step end (h, local error): {}; slope {pe:.3}", sci(&end));
+        assert!((pi - 8.0).abs() < 0.3, "measured dense-output order {pi}");
+        assert!((pe - 9.0).abs() < 0.4, "measured local-error order {pe}");
+    }
+
+    /// `y' = −2t·y²`, `y(0) = 1`: `y = 1/(1 + t²)`. Non-autonomous, so the nodes `c` count.
+    struct Lorentzian;
+    impl OdeSystem for Lorentzian {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, t: f64, y: &[f64], d: &mut [f64]) {
+            d[0] = -2.0 * t * y[0] * y[0];
+        }
+    }
+
+    #[test]
+    fn convergence_order_is_eight_on_a_non_autonomous_problem() {
+        // Worst error over [0, 3] at the step ends and inside the steps (dense output):
+        // the global error of the steps and of the interpolant are both O(h⁸).
+        let t_end = 3.0;
+        let pts: Vec<(f64, f64)> = [15, 20, 25, 32, 40]
+            .iter()
+            .map(|&n| {
+                let h = t_end / n as f64;
+                let mut s = Dop853::new(0.0, &[1.0], FIXED, h, Some(h));
+                let (mut worst, mut out): (f64, _) = (0.0, [0.0]);
+                while s.t() < t_end {
+                    s.step(&Lorentzian, t_end).unwrap();
+                    for j in 1..=10 {
+                        let t = s.t_prev() + (s.t() - s.t_prev()) * j as f64 / 10.0;
+                        s.interpolate(t, &mut out);
+                        worst = worst.max((out[0] - 1.0 / (1.0 + t * t)).abs());
+                    }
+                }
+                assert_eq!(s.stats().steps, n);
+                (h, worst)
+            })
+            .collect();
+        let p = slope(&pts);
+        println!(
+            "y' = -2ty² fixed-step (h, worst error): {}; slope {p:.3}",
+            sci(&pts)
+        );
+        assert!(pts.iter().all(|&(_, e)| e > 1e-13), "errors near roundoff");
+        assert!((p - 8.0).abs() < 0.3, "measured order {p}");
+    }
+
+    #[test]
+    fn dense_output_is_as_accurate_as_the_steps() {
+        let mut s = Dop853::new(0.0, &[1.0, 0.0], tol(1e-10), f64::INFINITY, None);
+        let (mut worst_inside, mut worst_ends): (f64, f64) = (0.0, 0.0);
+        let mut out = [0.0; 2];
+        let err = |t: f64, y: &[f64]| (y[0] - t.cos()).abs().max((y[1] + t.sin()).abs());
+        while s.t() < 20.0 {
+            s.step(&Oscillator, 20.0).unwrap();
+            worst_ends = worst_ends.max(err(s.t(), s.y()));
+            let (a, b) = (s.t_prev(), s.t());
+            for j in 1..50 {
+                let t = a + (b - a) * j as f64 / 50.0;
+                s.interpolate(t, &mut out);
+                worst_inside = worst_inside.max(err(t, &out));
+            }
+            // The interpolant meets the step's ends.
+            s.interpolate(b - 1e-9 * (b - a), &mut out);
+            assert!(dist(&out, s.y()) < 1e-8 * (b - a));
+        }
+        println!(
+            "oscillator rtol 1e-10: worst inside {worst_inside:.2e}, at ends {worst_ends:.2e}"
+        );
+        assert!(worst_inside < 1e-9, "dense output error {worst_inside}");
+        assert!(worst_inside < 2.0 * worst_ends + 1e-12);
+    }
+
+    #[test]
+    fn global_error_follows_the_tolerance() {
+        let t_end = 20.0 * PI; // ten periods
+        let errs: Vec<f64> = [1e-6, 1e-8, 1e-10, 1e-12]
+            .iter()
+            .map(|&r| {
+                let mut s = Dop853::new(0.0, &[1.0, 0.0], tol(r), f64::INFINITY, None);
+                run(&mut s, &Oscillator, t_end);
+                dist(s.y(), &[t_end.cos(), -t_end.sin()])
+            })
+            .collect();
+        println!(
+            "oscillator, 10 periods, rtol 1e-6..1e-12: errors {}",
+            sci1(&errs)
+        );
+        for w in errs.windows(2) {
+            // Two decades of tolerance buy about two decades of accuracy.
+            let gain = w[0] / w[1];
+            assert!((30.0..300.0).contains(&gain), "errors {errs:?}");
+        }
+        assert!(errs[3] < 1e-9, "errors {errs:?}");
+    }
+
+    #[test]
+    fn meets_tolerance_on_exponential() {
+        let mut s = Dop853::new(0.0, &[1.0], tol(1e-10), f64::INFINITY, None);
+        run(&mut s, &Exponential(-0.7), 5.0);
+        let exact = (-0.7f64 * 5.0).exp();
+        assert!((s.y()[0] - exact).abs() < 1e-9 * exact);
+    }
+
+    /// y' = 1 from a large t0 with many steps: integrated time equals the label at the end,
+    /// and every step lands where it says.
+    #[test]
+    fn integrated_time_matches_the_time_label() {
+        let (t0, t_end) = (1.0e6, 1.0e6 + 1.0e4);
+        let mut s = Dop853::new(t0, &[0.0], tol(1e-10), 0.1, Some(0.1));
+        let mut steps = 0;
+        while s.t() < t_end {
+            let t = s.step(&Clock, t_end).unwrap();
+            assert_eq!(t, s.t());
+            steps += 1;
+        }
+        assert_eq!(s.t(), t_end);
+        assert!((s.y()[0] - 1.0e4).abs() < 1e-9, "y = {}", s.y()[0]);
+        assert_eq!(s.stats().steps, steps);
+    }
+
+    #[test]
+    fn steps_land_exactly_on_intermediate_ends() {
+        let mut s = Dop853::new(0.0, &[1.0, 0.0], tol(1e-8), f64::INFINITY, None);
+        for j in 1..=30 {
+            let t_end = 0.37 * j as f64;
+            while s.t() < t_end {
+                let t = s.step(&Oscillator, t_end).unwrap();
+                assert!(t <= t_end);
+            }
+            assert_eq!(s.t(), t_end);
+        }
+    }
+
+    #[test]
+    fn counts_every_right_hand_side_evaluation() {
+        // Independently counted calls equal the stats and the documented formula:
+        // 1 (f(t0)) [+ 1 (starting step)] + 15·accepted + 11·rejected.
+        for (h0, dense, per_step) in [(None, true, 15), (Some(1.0), true, 15), (None, false, 12)] {
+            let sys = Counted::new(&Kepler);
+            let mut s = Dop853::new(0.0, &kepler_exact(0.5, 0.0), tol(1e-10), f64::INFINITY, h0)
+                .with_dense_output(dense);
+            run(&mut s, &sys, 10.0);
+            let st = s.stats();
+            let start = if h0.is_some() { 1 } else { 2 };
+            assert_eq!(st.rhs_evaluations, sys.calls.get());
+            assert_eq!(
+                st.rhs_evaluations,
+                start + per_step * st.steps + 11 * st.rejected_steps
+            );
+            if h0.is_some() {
+                // A first step of 1 at rtol 1e-10 is rejected at least once.
+                assert!(st.rejected_steps > 0);
+            }
+        }
+    }
+
+    #[test]
+    fn fewer_evaluations_than_dopri5_at_tight_tolerance() {
+        let t_end = 200.0 * PI; // 100 periods
+        let exact = [t_end.cos(), -t_end.sin()];
+        let mut a = Dopri5::new(0.0, &[1.0, 0.0], tol(1e-10), f64::INFINITY, None);
+        while a.t() < t_end {
+            a.step(&Oscillator, t_end).unwrap();
+        }
+        let mut b = Dop853::new(0.0, &[1.0, 0.0], tol(1e-10), f64::INFINITY, None);
+        run(&mut b, &Oscillator, t_end);
+        let (na, nb) = (a.stats().rhs_evaluations, b.stats().rhs_evaluations);
+        println!(
+            "oscillator, 100 periods, rtol 1e-10: dopri5 {na} evaluations (error {:.1e}), \
+             dop853 {nb} (error {:.1e}), {} without dense output",
+            dist(a.y(), &exact),
+            dist(b.y(), &exact),
+            nb - 3 * b.stats().steps
+        );
+        assert!(nb < na, "dop853 {nb} vs dopri5 {na}");
+    }
+
+    /// y' = y² from y(0) = 1 blows up at t = 1.
+    struct BlowUp;
+    impl OdeSystem for BlowUp {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, _t: f64, y: &[f64], d: &mut [f64]) {
+            d[0] = y[0] * y[0];
+        }
+    }
+
+    /// y' = 1, but the model is undefined (NaN) after `self.0`.
+    struct UndefinedAfter(f64);
+    impl OdeSystem for UndefinedAfter {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, t: f64, _y: &[f64], d: &mut [f64]) {
+            d[0] = if t > self.0 { f64::NAN } else { 1.0 };
+        }
+    }
+
+    /// y' = 1, but the `n`-th call returns infinity.
+    struct FailsOnCall(u64, std::cell::Cell<u64>);
+    impl OdeSystem for FailsOnCall {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&self, _t: f64, _y: &[f64], d: &mut [f64]) {
+            self.1.set(self.1.get() + 1);
+            d[0] = if self.1.get() == self.0 {
+                f64::INFINITY
+            } else {
+                1.0
+            };
+        }
+    }
+
+    #[test]
+    fn singularity_is_a_step_size_underflow() {
+        let mut s = Dop853::new(0.0, &[1.0], tol(1e-8), f64::INFINITY, None);
+        let err = loop {
+            match s.step(&BlowUp, 2.0) {
+                // The numerical solution blows up within ~1e-11 of t = 1.
+                Ok(_) => assert!(s.t() < 1.0 + 1e-6),
+                Err(e) => break e,
+            }
+        };
+        match err {
+            StepError::StepSizeUnderflow { t, h } => {
+                assert!((t - 1.0).abs() < 1e-6, "t = {t}");
+                assert!(h.abs() < 1e-12, "h = {h}");
+            }
+            e => panic!("expected StepSizeUnderflow, got {e:?}"),
+        }
+    }
+
+    #[test]
+    fn non_finite_derivative_is_reported() {
+        // Undefined from the start.
+        let mut s = Dop853::new(1.0, &[0.0], tol(1e-8), f64::INFINITY, None);
+        assert_eq!(
+            s.step(&UndefinedAfter(0.5), 2.0),
+            Err(StepError::NonFiniteDerivative { t: 1.0 })
+        );
+        // Undefined after t = 0.5: the steps close in on it, then give up there.
+        let mut s = Dop853::new(0.0, &[0.0], tol(1e-8), f64::INFINITY, None);
+        let err = loop {
+            match s.step(&UndefinedAfter(0.5), 2.0) {
+                Ok(t) => assert!(t <= 0.5),
+                Err(e) => break e,
+            }
+        };
+        match err {
+            StepError::NonFiniteDerivative { t } => assert!((t - 0.5).abs() < 1e-9, "t = {t}"),
+            e => panic!("expected NonFiniteDerivative, got {e:?}"),
+        }
+    }
+
+    #[test]
+    fn non_finite_stage_at_the_new_point_rejects_the_step() {
+        // Calls: 1 = f(t0), 2–12 = stages of the first try, 13 = f at its end: infinite. The
+        // step is retried at a tenth of the size and accepted.
+        let sys = FailsOnCall(13, std::cell::Cell::new(0));
+        let mut s = Dop853::new(0.0, &[0.0], tol(1e-8), f64::INFINITY, Some(0.5));
+        assert_eq!(s.step(&sys, 10.0), Ok(0.05));
+        let st = s.stats();
+        assert_eq!((st.steps, st.rejected_steps), (1, 1));
+        assert_eq!(st.rhs_evaluations, 1 + 12 + 15);
+        assert_eq!(st.rhs_evaluations, sys.1.get());
+        assert!((s.y()[0] - 0.05).abs() < 1e-15);
+    }
+
+    #[test]
+    #[should_panic(expected = "dense output")]
+    fn interpolating_without_dense_output_panics() {
+        let mut s =
+            Dop853::new(0.0, &[1.0, 0.0], tol(1e-8), f64::INFINITY, None).with_dense_output(false);
+        s.step(&Oscillator, 10.0).unwrap();
+        let mut out = [0.0; 2];
+        // The ends are still available.
+        s.interpolate(s.t_prev(), &mut out);
+        assert_eq!(out, [1.0, 0.0]);
+        s.interpolate(s.t(), &mut out);
+        assert_eq!(out, s.y());
+        s.interpolate(0.5 * s.t(), &mut out);
+    }
+}
