@@ -123,6 +123,38 @@ enum BenchCommand {
         #[command(flatten)]
         sweep: SweepArgs,
     },
+    /// Invariant drift of every method over a long torque-free tumble (charts and CSV).
+    Drift {
+        /// Simulated time (s).
+        #[arg(long, default_value_t = 1e5)]
+        duration: f64,
+        #[command(flatten)]
+        out: OutArgs,
+    },
+    /// Largest stable step of every method against the stiffness of a damper (chart, CSV).
+    Stability {
+        #[command(flatten)]
+        out: OutArgs,
+    },
+    /// Error growth of every method near the separatrix, with the problem's conditioning.
+    Separatrix {
+        /// Simulated time (s).
+        #[arg(long, default_value_t = 100.0)]
+        duration: f64,
+        #[command(flatten)]
+        out: OutArgs,
+    },
+}
+
+/// Where a benchmark writes, and how loudly.
+#[derive(clap::Args, Debug, Clone)]
+struct OutArgs {
+    /// Directory for the charts (SVG and PNG) and CSV.
+    #[arg(long, default_value = "docs/figures")]
+    out: PathBuf,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 /// Method options shared by `run` and `bench point`.
@@ -218,7 +250,7 @@ pub fn main() -> i32 {
             summary,
             quiet,
         } => {
-let overrides = method.overrides(duration, out);
+            let overrides = method.overrides(duration, out);
             run(&scenario, &overrides, no_log, summary.as_deref(), quiet)
         }
     }
@@ -247,6 +279,51 @@ fn bench_cmd(what: BenchCommand) -> i32 {
                 }
             }
         }
+        BenchCommand::Drift { duration, out } => {
+            if !(duration.is_finite() && duration > 0.0) {
+                eprintln!("error: --duration: expected a positive number of seconds");
+                return EXIT_BAD_INPUT;
+            }
+            if let Err(code) = make_dir(&out.out) {
+                return code;
+            }
+            report_files(
+                crate::bench::failure::drift(
+                    Path::new("."),
+                    duration,
+                    &out.out,
+                    bench_progress(out.quiet),
+                ),
+                out.quiet,
+            )
+        }
+        BenchCommand::Stability { out } => {
+            if let Err(code) = make_dir(&out.out) {
+                return code;
+            }
+            report_files(
+                crate::bench::failure::stability(&out.out, bench_progress(out.quiet)),
+                out.quiet,
+            )
+        }
+        BenchCommand::Separatrix { duration, out } => {
+            if !(duration.is_finite() && duration > 0.0 && duration <= 1e4) {
+                eprintln!("error: --duration: expected a positive number of seconds up to 1e4");
+                return EXIT_BAD_INPUT;
+            }
+            if let Err(code) = make_dir(&out.out) {
+                return code;
+            }
+            report_files(
+                crate::bench::failure::separatrix(
+                    Path::new("."),
+                    duration,
+                    &out.out,
+                    bench_progress(out.quiet),
+                ),
+                out.quiet,
+            )
+        }
         BenchCommand::WorkPrecision { problems, sweep } => {
             use crate::bench::work_precision::{PROBLEMS, Problem};
             let chosen: Vec<Problem> = if problems.is_empty() {
@@ -272,9 +349,8 @@ fn bench_cmd(what: BenchCommand) -> i32 {
                 Ok(m) => m,
                 Err(code) => return code,
             };
-            if let Err(e) = std::fs::create_dir_all(&sweep.out) {
-                eprintln!("error: {}: {e}", sweep.out.display());
-                return EXIT_IO;
+            if let Err(code) = make_dir(&sweep.out) {
+                return code;
             }
             let budget = crate::bench::Budget {
                 seconds_per_point: sweep.budget,
@@ -321,6 +397,13 @@ fn bench_progress(quiet: bool) -> impl FnMut(&str) {
             eprintln!("{line}");
         }
     }
+}
+
+fn make_dir(dir: &Path) -> Result<(), i32> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        eprintln!("error: {}: {e}", dir.display());
+        EXIT_IO
+    })
 }
 
 fn report_files(result: Result<Vec<PathBuf>, String>, quiet: bool) -> i32 {

@@ -935,9 +935,20 @@ pub fn stiffness(sc: &Spacecraft, t: f64, y: &[f64], duration: f64) -> Stiffness
     );
     let m = cols.len();
     let jac = DMatrix::from_fn(m, m, |r, c| full[(cols[r], c)]);
-    let eig = jac.complex_eigenvalues();
-    let spectral_radius = eig.iter().map(|l| l.norm()).fold(0.0, f64::max);
-    let fastest_decay = eig.iter().map(|l| (-l.re).max(0.0)).fold(0.0, f64::max);
+    // A state far out (a diverging run) can make the Jacobian non-finite or the Schur
+    // iteration slow to converge: bound it, and answer NaN rather than hang.
+    let eig = if jac.iter().all(|v| v.is_finite()) {
+        nalgebra::linalg::Schur::try_new(jac, f64::EPSILON, 10_000).map(|s| s.complex_eigenvalues())
+    } else {
+        None
+    };
+    let (spectral_radius, fastest_decay) = match eig {
+        Some(eig) => (
+            eig.iter().map(|l| l.norm()).fold(0.0, f64::max),
+            eig.iter().map(|l| (-l.re).max(0.0)).fold(0.0, f64::max),
+        ),
+        None => (f64::NAN, f64::NAN),
+    };
     let omega = Vector3::new(y[0], y[1], y[2]).norm();
     Stiffness {
         spectral_radius,

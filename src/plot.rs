@@ -133,8 +133,9 @@ pub struct Chart {
 
 /// Okabe–Ito colour-blind-safe palette, reordered so that the colours with
 /// the best contrast on white come first (yellow last).
-const PALETTE: [&str; 8] = [
+const PALETTE: [&str; 12] = [
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442",
+    "#882255", "#44AA99", "#999933", "#AA4499",
 ];
 /// Series with more finite points than this are decimated for drawing.
 const DECIMATE_THRESHOLD: usize = 4000;
@@ -1331,13 +1332,20 @@ pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
     {
         let db = options.fontdb_mut();
         db.load_system_fonts();
-        if db.faces().any(|f| f.families.iter().any(|(n, _)| n == "DejaVu Sans")) {
+        if db
+            .faces()
+            .any(|f| f.families.iter().any(|(n, _)| n == "DejaVu Sans"))
+        {
             db.set_sans_serif_family("DejaVu Sans");
         }
     }
     let tree = usvg::Tree::from_str(svg, &options).map_err(|e| format!("SVG: {e}"))?;
     let scale = 2.0;
-    let size = tree.size().to_int_size().scale_by(scale).ok_or("empty chart")?;
+    let size = tree
+        .size()
+        .to_int_size()
+        .scale_by(scale)
+        .ok_or("empty chart")?;
     let mut pixmap =
         tiny_skia::Pixmap::new(size.width(), size.height()).ok_or("chart too large")?;
     pixmap.fill(tiny_skia::Color::WHITE);

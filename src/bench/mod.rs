@@ -6,6 +6,7 @@
 //! output sampling), measured in this process: the machines are shared and noisy, and the
 //! minimum is the least disturbed estimate of the method's cost.
 
+pub mod failure;
 pub mod work_precision;
 
 use crate::integrate::Stats;

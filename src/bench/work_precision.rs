@@ -252,9 +252,7 @@ pub fn sweep(
         Some(1e-6),
     )?;
     let spin = base.omega0.norm().max(1.0 / problem.duration);
-    let y0 = base
-        .spacecraft
-        .initial_state(&base.omega0, &base.attitude0);
+    let y0 = base.spacecraft.initial_state(&base.omega0, &base.attitude0);
     let stiff = crate::linearize::stiffness(&base.spacecraft, 0.0, &y0, problem.duration);
     // Coarsest fixed step: a radian of rotation, or the explicit stability bound.
     let dt_coarse = (1.0 / spin).min(2.5 / stiff.spectral_radius.max(spin));

@@ -685,7 +685,7 @@ mod tests {
     use super::*;
     use crate::integrate::Dopri5;
     use crate::integrate::test_systems::{
-        Clock, Counted, Exponential, Kepler, Oscillator, EulerBody, kepler_exact,
+        Clock, Counted, EulerBody, Exponential, Kepler, Oscillator, kepler_exact,
     };
     use std::f64::consts::PI;
 

@@ -9,8 +9,8 @@
 mod dop853;
 mod dopri5;
 mod gauss;
-mod radau5;
 pub mod jacobian;
+mod radau5;
 mod rk4;
 #[cfg(test)]
 mod test_systems;

@@ -740,7 +740,7 @@ mod tests {
     use super::*;
     use crate::integrate::Dopri5;
     use crate::integrate::test_systems::{
-        Clock, Exponential, Oscillator, EulerBody, Robertson, StiffSpring, VanDerPol,
+        Clock, EulerBody, Exponential, Oscillator, Robertson, StiffSpring, VanDerPol,
     };
 
     const BODY: EulerBody = EulerBody([1.0, 2.0, 3.0]);

@@ -396,7 +396,10 @@ impl Method {
             Method::Dop853(a) => format!("dop853 ({})", a.describe()),
             Method::Radau5(a) => format!("radau5 ({})", a.describe()),
             Method::Gauss { dt, stages } => {
-                format!("gauss ({stages} stage(s), order {}, dt {dt:e} s)", 2 * stages)
+                format!(
+                    "gauss ({stages} stage(s), order {}, dt {dt:e} s)",
+                    2 * stages
+                )
             }
             Method::Lie { dt } => format!("lie (RKMK4, dt {dt:e} s)"),
             Method::Splitting { dt, order } => format!("splitting (order {order}, dt {dt:e} s)"),

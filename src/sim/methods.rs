@@ -11,7 +11,8 @@
 
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{
-    Dop853, Dopri5, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError, Stepper, Tolerances,
+    Dop853, Dopri5, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError, Stepper,
+    Tolerances,
 };
 use crate::model::Spacecraft;
 use crate::scenario::{Method, Scenario};
@@ -43,7 +44,11 @@ impl AnyStepper {
     /// the method cannot treat this spacecraft. Without `dense_output`, a method may skip
     /// the work that only interpolation needs (dop853's three extra stages), and then
     /// `interpolate` is valid at the step's ends only.
-    pub fn for_scenario(scenario: &Scenario, y0: &[f64], dense_output: bool) -> Result<Self, String> {
+    pub fn for_scenario(
+        scenario: &Scenario,
+        y0: &[f64],
+        dense_output: bool,
+    ) -> Result<Self, String> {
         let sc = &scenario.spacecraft;
         let tol = |a: crate::scenario::Adaptive| {
             (
