@@ -859,6 +859,9 @@ struct Summary<'a> {
     scenario_file: String,
     method: &'static str,
     method_settings: String,
+    /// Why `auto` picked the method (absent when it was named).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    method_choice: Option<&'a str>,
     body: Body,
     status: &'a Status,
     mcap: Option<String>,
@@ -873,6 +876,10 @@ struct Summary<'a> {
     steps: u64,
     rejected_steps: u64,
     rhs_evaluations: u64,
+    /// Newton iterations, Jacobians and LU factorisations (implicit methods).
+    newton_iterations: u64,
+    jacobian_evaluations: u64,
+    factorizations: u64,
     samples: u64,
     wall_time_s: f64,
     events: &'a [sim::EventRecord],
@@ -968,6 +975,7 @@ fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         scenario_file: s.path.display().to_string(),
         method: s.method.name(),
         method_settings: s.method.describe(),
+        method_choice: s.method_choice.as_deref(),
         body: body(s),
         status: &o.status,
         mcap: mcap.map(|p| p.display().to_string()),
@@ -988,6 +996,9 @@ fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         steps: o.stats.steps,
         rejected_steps: o.stats.rejected_steps,
         rhs_evaluations: o.stats.rhs_evaluations,
+        newton_iterations: o.stats.newton_iterations,
+        jacobian_evaluations: o.stats.jacobian_evaluations,
+        factorizations: o.stats.factorizations,
         samples: o.samples,
         wall_time_s: o.wall_time,
         events: &o.events,
@@ -999,6 +1010,9 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     let f = &o.final_observation;
     let q = f.attitude;
     println!("{} — {}", s.name, s.method.describe());
+    if let Some(why) = &s.method_choice {
+        println!("  {why}");
+    }
     let b = body(s);
     let m = b.principal_moments;
     println!(
@@ -1073,6 +1087,12 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
         "  work: {} steps ({} rejected), {} RHS evaluations, {} samples, {:.3} s wall",
         o.stats.steps, o.stats.rejected_steps, o.stats.rhs_evaluations, o.samples, o.wall_time
     );
+    if s.method.is_implicit() {
+        println!(
+            "  implicit: {} Newton iterations, {} Jacobians, {} LU factorisations",
+            o.stats.newton_iterations, o.stats.jacobian_evaluations, o.stats.factorizations
+        );
+    }
     for e in &o.events {
         println!(
             "  event: t = {:.9} s  {}{}",

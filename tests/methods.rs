@@ -98,7 +98,9 @@ fn damped_reference() -> Vec<f64> {
 #[test]
 fn fixed_step_methods_converge_at_their_nominal_order_on_a_damped_spacecraft() {
     let reference = damped_reference();
-    let cases: [(&str, Option<u32>, Option<u32>, f64, [f64; 4]); 6] = [
+    // (method, stages, order, nominal order, steps)
+    type Case = (&'static str, Option<u32>, Option<u32>, f64, [f64; 4]);
+    let cases: [Case; 6] = [
         ("rk4", None, None, 4.0, [0.2, 0.1, 0.05, 0.025]),
         ("lie", None, None, 4.0, [0.2, 0.1, 0.05, 0.025]),
         ("splitting", None, Some(2), 2.0, [0.2, 0.1, 0.05, 0.025]),

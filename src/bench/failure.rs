@@ -11,12 +11,15 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
+/// Running maxima of (|ΔE|/E, |Δ|H||/|H|, ||q| − 1|) at sample times.
+type DriftCurve = Vec<(f64, [f64; 3])>;
+
 /// Keeps every output sample's time and state.
 #[derive(Default)]
 struct Recorder {
     samples: Vec<(f64, Vec<f64>)>,
     /// Running maxima of |ΔE|/E, |Δ|H||/|H|, ||q| − 1| at each sample.
-    drift: Vec<(f64, [f64; 3])>,
+    drift: DriftCurve,
     worst: [f64; 3],
 }
 
@@ -93,7 +96,7 @@ pub fn drift(
         setting("exact", None),
     ];
     let path = root.join("scenarios/generic-tumble.yaml");
-    let mut curves: Vec<(String, Vec<(f64, [f64; 3])>)> = Vec::new();
+    let mut curves: Vec<(String, DriftCurve)> = Vec::new();
     let mut table = String::from(
         "method,steps,rhs_evaluations,wall_s,final_energy_rel,final_h_rel,final_q_norm\n",
     );
@@ -219,7 +222,7 @@ pub fn stability(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
         .copied()
         .collect();
     let mut csv = String::from("method,stiffness_N_per_m,largest_abs_lambda,step_s,kind\n");
-    let mut series: Vec<(String, Vec<(f64, f64)>, Style)> = Vec::new();
+    let mut series: Vec<Series> = Vec::new();
     for m in &fixed {
         let mut pts = Vec::new();
         for &k in &stiffnesses {
@@ -260,7 +263,7 @@ pub fn stability(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             let _ = writeln!(csv, "{},{k:e},{lam:e},{h:e},{kind}", m.label);
             pts.push((lam, h));
         }
-        series.push((m.label.to_string(), pts, Style::LineMarkers));
+        series.push(Series::new(m.label, pts, Style::LineMarkers));
     }
     for m in &adaptive {
         let mut pts = Vec::new();
@@ -279,7 +282,11 @@ pub fn stability(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
             let _ = writeln!(csv, "{},{k:e},{lam:e},{h:e},mean accepted step", m.label);
             pts.push((lam, h));
         }
-        series.push((format!("{} (mean step)", m.label), pts, Style::Dashed));
+        series.push(Series::new(
+            format!("{} (mean step)", m.label),
+            pts,
+            Style::Dashed,
+        ));
     }
     let mut c = Chart::new(
         "Stability map: stiff spring-mass damper on a spinning hub",
@@ -288,9 +295,7 @@ pub fn stability(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     );
     c.x_scale = Scale::Log10;
     c.y_scale = Scale::Log10;
-    for (name, pts, style) in series {
-        c.series.push(Series::new(name, pts, style));
-    }
+    c.series.extend(series);
     let lams: Vec<f64> = stiffnesses
         .iter()
         .map(|&k| lambda(k).unwrap_or(f64::NAN))

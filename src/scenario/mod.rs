@@ -820,7 +820,7 @@ impl ScenarioFile {
                 None => Ok(None),
                 Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
                 Some(x) => {
-                    let (l, f) = from(v.map(f64::from), s.as_ref().and_then(loc), field, flag);
+                    let (l, f) = from(v, s.as_ref().and_then(loc), field, flag);
                     Err(err(
                         l,
                         f,

@@ -538,8 +538,8 @@ impl Stepper for SplittingStepper {
         let h10 = th * (1.0 - th) * (1.0 - th);
         let h01 = th * th * (3.0 - 2.0 * th);
         let h11 = th * th * (th - 1.0);
-        for i in 0..out.len() {
-            out[i] = h00 * self.y_prev[i]
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = h00 * self.y_prev[i]
                 + h * h10 * self.f_prev[i]
                 + h01 * self.y[i]
                 + h * h11 * self.f_end[i];
