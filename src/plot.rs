@@ -1324,7 +1324,7 @@ fn count_hits(style: Style, pieces: &[Vec<(f64, f64)>], rect: &Rect) -> usize {
     n
 }
 
-/// Renders an SVG document (as written by [`Chart::to_svg`]) to a PNG file at twice its
+/// Renders an SVG document (as written by [`Chart::to_svg`]) to a PNG file at 1.5 times its
 /// size, on white, with the system's fonts (DejaVu Sans for `sans-serif` when present).
 pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
     use resvg::{tiny_skia, usvg};
@@ -1340,7 +1340,7 @@ pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
         }
     }
     let tree = usvg::Tree::from_str(svg, &options).map_err(|e| format!("SVG: {e}"))?;
-    let scale = 2.0;
+    let scale = 1.5;
     let size = tree
         .size()
         .to_int_size()

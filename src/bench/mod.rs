@@ -129,7 +129,7 @@ pub fn load_with(
     scenario::load(path, &overrides).map_err(|e| e.to_string())
 }
 
-/// Writes `chart` as `<stem>.svg` and `<stem>.png` (900×600 px); returns both paths.
+/// Writes `chart` as `<stem>.svg` (900×600) and `<stem>.png` (1350×900 px); returns both paths.
 pub fn svg_and_png(chart: &Chart, stem: &Path) -> Result<Vec<PathBuf>, String> {
     let svg = chart.to_svg(900, 600);
     let svg_path = stem.with_extension("svg");
