@@ -348,3 +348,139 @@ fn auto_picks_exact_explicit_or_implicit_from_the_scene_and_says_why() {
     );
     assert!(stiff.method_choice.as_deref().unwrap().contains("stiff"));
 }
+
+/// Keeps every output sample.
+#[derive(Default)]
+struct Samples(Vec<(f64, Vec<f64>)>);
+
+impl sim::Sink for Samples {
+    fn sample(
+        &mut self,
+        o: &polhode::model::Observation,
+        y: &[f64],
+        _: &sim::Reference,
+    ) -> std::io::Result<()> {
+        self.0.push((o.t, y.to_vec()));
+        Ok(())
+    }
+    fn event(
+        &mut self,
+        _: &sim::EventRecord,
+        _: &polhode::model::Observation,
+    ) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+fn samples(s: &Scenario) -> Vec<(f64, Vec<f64>)> {
+    let interrupt = AtomicBool::new(false);
+    let mut sink = Samples::default();
+    sim::run(
+        s,
+        &mut sink,
+        Control {
+            interrupt: &interrupt,
+            progress: None,
+        },
+    )
+    .expect("no I/O");
+    sink.0
+}
+
+/// Largest attitude and ω error of `test`'s samples against `reference`'s at the same times.
+fn worst_sample_error(reference: &[(f64, Vec<f64>)], test: &[(f64, Vec<f64>)]) -> (f64, f64) {
+    assert_eq!(reference.len(), test.len());
+    let mut worst = (0.0f64, 0.0f64);
+    for ((tr, yr), (tt, yt)) in reference.iter().zip(test) {
+        assert!((tr - tt).abs() < 1e-12);
+        let dw = (0..3).map(|i| (yt[i] - yr[i]).powi(2)).sum::<f64>().sqrt();
+        worst.0 = worst.0.max(attitude_error(&yr[3..7], &yt[3..7]));
+        worst.1 = worst.1.max(dw);
+        let qn = yt[3..7].iter().map(|c| c * c).sum::<f64>().sqrt();
+        assert!(
+            (qn - 1.0).abs() < 1e-12,
+            "|q| − 1 = {:e} at t = {tt}",
+            qn - 1.0
+        );
+    }
+    worst
+}
+
+#[test]
+fn dense_output_between_steps_is_as_good_as_the_steps() {
+    // Samples at 7 Hz fall inside long fixed steps (1 s, 0.05 s).
+    let at_7_hz = |ov: Overrides, yaml: Option<&str>| {
+        let mut s = match yaml {
+            Some(y) => parse(y, ov),
+            None => load(
+                "scenarios/generic-tumble.yaml",
+                Overrides {
+                    duration: Some(20.0),
+                    ..ov
+                },
+            ),
+        };
+        s.output_rate = 7.0;
+        samples(&s)
+    };
+    // Torque-free: splitting interpolates along the exact free flow.
+    let exact = at_7_hz(method("exact"), None);
+    let split = at_7_hz(
+        Overrides {
+            dt: Some(1.0),
+            ..method("splitting")
+        },
+        None,
+    );
+    let (att, w) = worst_sample_error(&exact, &split);
+    eprintln!("splitting, torque-free, dt 1 s: samples off by {att:e} rad, {w:e} rad/s");
+    assert!(att < 1e-10 && w < 1e-10);
+    let lie = at_7_hz(
+        Overrides {
+            dt: Some(0.05),
+            ..method("lie")
+        },
+        None,
+    );
+    let (att, w) = worst_sample_error(&exact, &lie);
+    eprintln!("lie, torque-free, dt 0.05 s: samples off by {att:e} rad, {w:e} rad/s");
+    assert!(att < 1e-5 && w < 1e-5);
+    // Damped: against dop853's dense output at rtol 1e-13; interior samples no worse than
+    // 10× the step ends' error of the same run.
+    let reference = at_7_hz(
+        Overrides {
+            rtol: Some(1e-13),
+            atol: Some(1e-15),
+            ..method("dop853")
+        },
+        Some(DAMPED),
+    );
+    for (name, order) in [("splitting", Some(4)), ("lie", None)] {
+        let dt = 0.1;
+        let run = at_7_hz(
+            Overrides {
+                dt: Some(dt),
+                order,
+                ..method(name)
+            },
+            Some(DAMPED),
+        );
+        let (att, w) = worst_sample_error(&reference, &run);
+        let end = error(
+            &damped_reference(),
+            &final_state(&parse(
+                DAMPED,
+                Overrides {
+                    dt: Some(dt),
+                    order,
+                    ..method(name)
+                },
+            )),
+        );
+        eprintln!("{name}, damped, dt {dt}: samples off by {att:e} rad, {w:e} rad/s; end {end:e}");
+        assert!(
+            att.max(w) < 10.0 * end.max(1e-12),
+            "{name}: {att:e} {w:e} vs {end:e}"
+        );
+    }
+}

@@ -158,8 +158,12 @@ pub fn drift(
     Ok(files)
 }
 
-/// The stiff scene of the stability map: a spinning hub with a critically damped
-/// spring-mass damper of 1 kg and stiffness `k` (N/m), so its mode decays at √k 1/s.
+/// The stiff scene of the stability map: a spinning hub with a 1 kg spring-mass damper of
+/// stiffness `k` (N/m) and damping 2√k N s/m (critical for the particle alone; coupled to the
+/// hub the mode is overdamped, its fastest eigenvalue ≈ 1.21 √k 1/s), started off its rest
+/// position by 1 mm·√(100/k): its own mode carries the same small energy (5e-5 J, against the
+/// hub's 7.5 J) at every stiffness, so that integration error in the dissipated-energy
+/// bookkeeping of a stiff, stable run cannot trip the divergence guard.
 fn stiff_scene(k: f64, duration: f64, ov: Overrides) -> Result<Scenario, String> {
     let c = 2.0 * k.sqrt();
     let yaml = format!(
@@ -168,12 +172,13 @@ body: {{mass: 100.0, principal: [10.0, 12.0, 15.0], spin_axis: [0, 0, 1]}}
 effectors:
   - spring_mass_damper:
       {{name: damper, mass: 1.0, position: [0.5, 0, 0], direction: [0, 0, 1],
-       stiffness: {k:e}, damping: {c:e}}}
+       stiffness: {k:e}, damping: {c:e}, initial_offset: {x0:e}}}
 initial: {{omega: [0.05, 0.0, 1.0]}}
 duration: {duration:e}
 output: {{rate: {rate:e}}}
 ",
-        rate = 4.0 / duration
+        rate = 4.0 / duration,
+        x0 = 1e-3 * (100.0 / k).sqrt()
     );
     scenario::parse(Path::new("stiff-damper.yaml"), yaml, &ov).map_err(|e| e.to_string())
 }
@@ -191,14 +196,21 @@ fn overrides(m: &MethodSpec, knob: Option<f64>) -> Overrides {
     }
 }
 
-/// Whether `m` at fixed step `dt` runs 200 steps of the stiff scene without diverging.
+/// Whether `m` at fixed step `dt` runs 200 steps of the stiff scene stably: it completes, and
+/// the damper's own mode has not grown (its elastic energy at the end is at most its initial
+/// one: a stable step damps it, an unstable one amplifies it by |R(hλ)|² per step, however
+/// small its share of the total energy).
 fn stable(k: f64, m: &MethodSpec, dt: f64) -> bool {
     let Ok(s) = stiff_scene(k, 200.0 * dt, overrides(m, Some(dt))) else {
         return false;
     };
     let mut sink = NullSink;
     match run_into(&s, &mut sink) {
-        Ok(o) => o.status == Status::Completed && o.drift.energy_rel < 0.1,
+        Ok(o) => {
+            o.status == Status::Completed
+                && o.final_observation.elastic_energy.is_finite()
+                && o.final_observation.elastic_energy <= o.initial_observation.elastic_energy
+        }
         Err(_) => false,
     }
 }

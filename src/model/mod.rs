@@ -543,6 +543,7 @@ impl Spacecraft {
 /// a quarter of a one-damper scene's right-hand side (measured with perf). `None` when `m` is
 /// not positive definite.
 #[inline]
+#[allow(clippy::needless_range_loop)] // index arithmetic mirrors the textbook algorithm
 fn cholesky_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
     let mut l = [[0.0f64; 6]; 6];
     for j in 0..6 {

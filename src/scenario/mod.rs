@@ -1155,6 +1155,24 @@ impl ScenarioFile {
         }
         let (method, method_choice) = if auto {
             let (m, why) = choose_method(&spacecraft, &omega0, &attitude0, duration, adaptive);
+            // The closed form steps for sampling and event bracketing: bound its work as the
+            // named method's is above.
+            let exact_steps = duration * output_rate.max(4.0 * omega0.norm());
+            if m == Method::Exact && exact_steps > 1e11 {
+                let (l, f) = if ov.duration.is_some() {
+                    (None, "--duration")
+                } else {
+                    (loc(&self.duration), "duration")
+                };
+                return Err(err(
+                    l,
+                    f,
+                    format!(
+                        "`auto` picked the exact solution, which would need at least \
+                         {exact_steps:.1e} evaluations; the limit is 1e11 (a shorter duration)"
+                    ),
+                ));
+            }
             (m, Some(why))
         } else {
             (method, None)
@@ -1206,6 +1224,14 @@ pub fn choose_method(
     }
     let y0 = sc.initial_state(omega0, attitude0);
     let st = crate::linearize::stiffness(sc, 0.0, &y0, duration);
+    if !st.ratio().is_finite() {
+        return (
+            Method::Dop853(adaptive),
+            "auto: the stiffness could not be measured at the initial state, so dop853 \
+             (explicit, order 8; it diagnoses stiffness if it meets it)"
+                .into(),
+        );
+    }
     if st.ratio() > AUTO_STIFFNESS_RATIO {
         (
             Method::Radau5(adaptive),
