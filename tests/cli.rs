@@ -908,3 +908,57 @@ fn auto_says_what_it_picked_and_unknown_methods_get_a_suggestion() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("integrator.dt"), "{}", stderr(&out));
 }
+
+#[test]
+fn methods_refuse_scenes_and_settings_they_do_not_apply_to() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let run = |args: &[&str]| {
+        polhode()
+            .current_dir(root)
+            .args(["run", "--no-log"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    // A prescribed hub motion has no free flow to compose with, and no closed form.
+    for (m, expect) in [
+        ("splitting", "composes the free rigid-body flow"),
+        ("exact", "torque-free rigid body only"),
+    ] {
+        let out = run(&["scenarios/spin-up.yaml", "--method", m, "--dt", "0.01"]);
+        assert_eq!(out.status.code(), Some(2), "{m}: {}", stderr(&out));
+        assert!(stderr(&out).contains(expect), "{m}: {}", stderr(&out));
+        assert!(stderr(&out).contains("--method"), "{}", stderr(&out));
+    }
+    // Another method's setting is refused, naming the option.
+    let out = run(&[
+        "scenarios/tennis-racket.yaml",
+        "--method",
+        "gauss",
+        "--dt",
+        "0.01",
+        "--order",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("--order") && stderr(&out).contains("`splitting` only"),
+        "{}",
+        stderr(&out)
+    );
+    let out = run(&[
+        "scenarios/tennis-racket.yaml",
+        "--method",
+        "gauss",
+        "--dt",
+        "0.01",
+        "--stages",
+        "3",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("expected 1 or 2, got 3"),
+        "{}",
+        stderr(&out)
+    );
+}

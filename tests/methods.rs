@@ -311,7 +311,8 @@ fn implicit_methods_stay_bounded_above_the_explicit_bound() {
         eprintln!("{label}: {:?} {:?} {:?}", o.status, o.drift, o.stats);
         assert_eq!(o.status, Status::Completed, "{label}");
         // Passive scene: the energy balance must not grow.
-        assert!(o.drift.energy_rel < 1e-3, "{label}: {:?}", o.drift);
+        // (Measured 3e-16 … 3e-11; an unstable method would grow it without bound.)
+        assert!(o.drift.energy_rel < 1e-8, "{label}: {:?}", o.drift);
         assert!(o.final_state.iter().all(|v| v.is_finite()));
     }
 }

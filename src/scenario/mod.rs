@@ -904,6 +904,45 @@ impl ScenarioFile {
             [2, 4],
             4,
         )?;
+        // Settings of one method given to another are mistakes, not no-ops.
+        for (given, flag, field, owner) in [
+            (
+                ov.stages.is_some() || spec.stages.is_some(),
+                ov.stages.is_some(),
+                "stages",
+                "gauss",
+            ),
+            (
+                ov.order.is_some() || spec.order.is_some(),
+                ov.order.is_some(),
+                "order",
+                "splitting",
+            ),
+        ] {
+            if given && method_name != owner {
+                let l = if flag {
+                    None
+                } else if field == "stages" {
+                    spec.stages.as_ref().and_then(loc)
+                } else {
+                    spec.order.as_ref().and_then(loc)
+                };
+                let f = match (flag, field) {
+                    (true, "stages") => "--stages",
+                    (true, _) => "--order",
+                    (false, "stages") => "integrator.stages",
+                    (false, _) => "integrator.order",
+                };
+                return Err(err(
+                    l,
+                    f,
+                    format!(
+                        "`{field}` applies to method `{owner}` only, and the method is \
+                         `{method_name}`"
+                    ),
+                ));
+            }
+        }
         let mut auto = false;
         let method = match method_name.as_str() {
             "rk4" => Method::Rk4 {
