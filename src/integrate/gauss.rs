@@ -43,6 +43,7 @@
 //! which also provides the starting guess of the next step's iteration by extrapolation
 //! (Hairer, Lubich & Wanner §VIII.6.1).
 
+use super::grid::FixedGrid;
 use super::jacobian::forward_difference;
 use super::{OdeSystem, Stats, StepError, Stepper};
 use nalgebra::DMatrix;
@@ -150,11 +151,8 @@ pub struct Gauss {
     a: [[f64; 2]; 2],
     b: [f64; 2],
     d: [f64; 2],
-    h: f64,
-    /// Start time and number of steps taken: step n ends at `t0 + n·h`, computed afresh each
-    /// step rather than accumulated, so the times carry no drift.
-    t0: f64,
-    n: u64,
+    /// Step n ends at `t0 + n·h` (see [`FixedGrid`]).
+    grid: FixedGrid,
     t: f64,
     t_prev: f64,
     y: Vec<f64>,
@@ -208,9 +206,7 @@ impl Gauss {
             a,
             b,
             d,
-            h,
-            t0,
-            n: 0,
+            grid: FixedGrid::new(t0, h),
             t: t0,
             t_prev: t0,
             y: y0.to_vec(),
@@ -236,7 +232,7 @@ impl Gauss {
 
     /// The nominal step (s).
     pub fn dt(&self) -> f64 {
-        self.h
+        self.grid.dt()
     }
 
     /// The method.
@@ -535,12 +531,7 @@ impl Stepper for Gauss {
         // increments add up to the times exactly.
         // A step shortened to an earlier t_end does not advance the grid index: the next step
         // then ends on the grid point it fell short of, and no step exceeds h.
-        let grid = self.t0 + (self.n + 1) as f64 * self.h;
-        let (mut t_next, mut on_grid) = (grid, true);
-        if grid >= t_end - 1e-9 * self.h {
-            t_next = t_end;
-            on_grid = grid <= t_end + 1e-9 * self.h;
-        }
+        let (t_next, on_grid) = self.grid.next(t_end);
         let t = self.t;
         let h = t_next - t;
         let failure = StepError::NewtonFailure { t, h };
@@ -600,9 +591,7 @@ impl Stepper for Gauss {
         std::mem::swap(&mut self.z, &mut self.z_step);
         self.t_prev = t;
         self.t = t_next;
-        if on_grid {
-            self.n += 1;
-        }
+        self.grid.advance(on_grid);
         self.stats.steps += 1;
         Ok(self.t)
     }

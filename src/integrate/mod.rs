@@ -9,6 +9,7 @@
 mod dop853;
 mod dopri5;
 mod gauss;
+mod grid;
 pub mod jacobian;
 mod radau5;
 mod rk4;
@@ -18,6 +19,7 @@ mod test_systems;
 pub use dop853::Dop853;
 pub use dopri5::Dopri5;
 pub use gauss::{Gauss, GaussStages};
+pub use grid::FixedGrid;
 pub use radau5::Radau5;
 pub use rk4::Rk4;
 

@@ -1,5 +1,6 @@
 //! Classic fourth-order Runge–Kutta with a fixed step and a third-order continuous extension.
 
+use super::grid::FixedGrid;
 use super::{OdeSystem, Stats, StepError, Stepper};
 
 /// Classic RK4, fixed step `dt` (the last step is shortened to land on `t_end`).
@@ -11,11 +12,8 @@ use super::{OdeSystem, Stats, StepError, Stepper};
 /// *Solving ODEs I*, §II.6), which needs no extra right-hand-side evaluation.
 #[derive(Debug, Clone)]
 pub struct Rk4 {
-    dt: f64,
-    /// Start time and number of steps taken: step n ends at `t0 + n·dt`, computed afresh each
-    /// step rather than accumulated, so the times carry no drift.
-    t0: f64,
-    n: u64,
+    /// Step n ends at `t0 + n·dt` (see [`FixedGrid`]).
+    grid: FixedGrid,
     t: f64,
     t_prev: f64,
     y: Vec<f64>,
@@ -30,9 +28,7 @@ impl Rk4 {
     pub fn new(t0: f64, y0: &[f64], dt: f64) -> Self {
         let n = y0.len();
         Rk4 {
-            dt,
-            t0,
-            n: 0,
+            grid: FixedGrid::new(t0, dt),
             t: t0,
             t_prev: t0,
             y: y0.to_vec(),
@@ -45,7 +41,7 @@ impl Rk4 {
 
     /// The nominal step (s).
     pub fn dt(&self) -> f64 {
-        self.dt
+        self.grid.dt()
     }
 }
 
@@ -122,14 +118,10 @@ impl Stepper for Rk4 {
     }
 
     fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError> {
-        // The step's end from the grid, landing exactly on t_end when within a small fraction
-        // of a step of it. The step size is the difference of the two times, so the
-        // increments add up to the times exactly (accumulating `t += dt` would make the
+        // The step's end from the grid; the step size is the difference of the two times, so
+        // the increments add up to the times exactly (accumulating `t += dt` would make the
         // integrated time lag the label by ~n·ulp).
-        let mut t_next = self.t0 + (self.n + 1) as f64 * self.dt;
-        if t_next >= t_end - 1e-9 * self.dt {
-            t_next = t_end;
-        }
+        let (t_next, on_grid) = self.grid.next(t_end);
         let t = self.t;
         let h = t_next - t;
         match self.y.len() {
@@ -140,7 +132,7 @@ impl Stepper for Rk4 {
         self.stats.rhs_evaluations += 4;
         self.t_prev = t;
         self.t = t_next;
-        self.n += 1;
+        self.grid.advance(on_grid);
         self.stats.steps += 1;
         Ok(self.t)
     }

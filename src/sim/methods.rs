@@ -11,8 +11,8 @@
 
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{
-    Dop853, Dopri5, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError, Stepper,
-    Tolerances,
+    Dop853, Dopri5, FixedGrid, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError,
+    Stepper, Tolerances,
 };
 use crate::model::Spacecraft;
 use crate::scenario::{Method, Scenario};
@@ -219,9 +219,7 @@ fn quat_of(y: &[f64]) -> Quat {
 /// applied in the algebra.
 #[derive(Debug, Clone)]
 pub struct LieStepper {
-    dt: f64,
-    t0: f64,
-    n: u64,
+    grid: FixedGrid,
     t: f64,
     t_prev: f64,
     y: Vec<f64>,
@@ -245,9 +243,7 @@ impl LieStepper {
     pub fn new(t0: f64, y0: &[f64], dt: f64) -> Self {
         let n = y0.len();
         LieStepper {
-            dt,
-            t0,
-            n: 0,
+            grid: FixedGrid::new(t0, dt),
             t: t0,
             t_prev: t0,
             y: y0.to_vec(),
@@ -286,10 +282,7 @@ impl Stepper for LieStepper {
     }
 
     fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError> {
-        let mut t_next = self.t0 + (self.n + 1) as f64 * self.dt;
-        if t_next >= t_end - 1e-9 * self.dt {
-            t_next = t_end;
-        }
+        let (t_next, on_grid) = self.grid.next(t_end);
         let t = self.t;
         let h = t_next - t;
         let w = |y: &[f64]| [y[0], y[1], y[2]];
@@ -330,7 +323,7 @@ impl Stepper for LieStepper {
         }
         self.t_prev = t;
         self.t = t_next;
-        self.n += 1;
+        self.grid.advance(on_grid);
         self.stats.steps += 1;
         Ok(t_next)
     }
@@ -377,13 +370,11 @@ impl Stepper for LieStepper {
 /// effectors' states take the cubic Hermite interpolant of the step's ends (f at each end:
 /// one extra evaluation per step, reused by the next).
 pub struct SplittingStepper {
-    dt: f64,
+    grid: FixedGrid,
     /// Strang weights of the composition.
     weights: Vec<f64>,
     inertia: Matrix3<f64>,
     inertia_inv: Matrix3<f64>,
-    t0: f64,
-    n: u64,
     t: f64,
     t_prev: f64,
     y: Vec<f64>,
@@ -412,12 +403,10 @@ impl SplittingStepper {
             vec![g1, 1.0 - 2.0 * g1, g1]
         };
         Ok(SplittingStepper {
-            dt,
+            grid: FixedGrid::new(t0, dt),
             weights,
             inertia,
             inertia_inv,
-            t0,
-            n: 0,
             t: t0,
             t_prev: t0,
             y: y0.to_vec(),
@@ -535,10 +524,7 @@ impl Stepper for SplittingStepper {
             sys.rhs(self.t, &self.y, &mut self.f_end);
             self.stats.rhs_evaluations += 1;
         }
-        let mut t_next = self.t0 + (self.n + 1) as f64 * self.dt;
-        if t_next >= t_end - 1e-9 * self.dt {
-            t_next = t_end;
-        }
+        let (t_next, on_grid) = self.grid.next(t_end);
         let t = self.t;
         let h = t_next - t;
         let mut y = self.y.clone();
@@ -552,7 +538,7 @@ impl Stepper for SplittingStepper {
         self.stats.rhs_evaluations += evals + 1;
         self.t_prev = t;
         self.t = t_next;
-        self.n += 1;
+        self.grid.advance(on_grid);
         self.stats.steps += 1;
         Ok(t_next)
     }
