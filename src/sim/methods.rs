@@ -385,6 +385,7 @@ pub struct SplittingStepper {
     f_end: Vec<f64>,
     /// The free flow from the last step's start, built on demand for dense output.
     free_flow: std::cell::OnceCell<Option<TorqueFreeSolution>>,
+    scratch: RkScratch,
     stats: Stats,
 }
 
@@ -414,6 +415,7 @@ impl SplittingStepper {
             f_prev: vec![0.0; y0.len()],
             f_end: Vec::new(),
             free_flow: std::cell::OnceCell::new(),
+            scratch: RkScratch::default(),
             stats: Stats::default(),
         })
     }
@@ -463,19 +465,27 @@ impl SplittingStepper {
         Ok(())
     }
 
-    /// One RK4 step of B over `tau` from `(t, y)`, in place; returns evaluations used.
-    fn flow_b<S: OdeSystem + ?Sized>(&self, sys: &S, t: f64, tau: f64, y: &mut [f64]) -> u64 {
+    /// One RK4 step of B over `tau` from `(t, y)`, in place, with the stages in `scratch`;
+    /// returns evaluations used.
+    fn flow_b<S: OdeSystem + ?Sized>(
+        &self,
+        sys: &S,
+        t: f64,
+        tau: f64,
+        y: &mut [f64],
+        scratch: &mut RkScratch,
+    ) -> u64 {
         let n = y.len();
-        let mut k = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let mut s = vec![0.0; n];
+        let RkScratch { k, stage } = scratch;
+        for v in k.iter_mut().chain(std::iter::once(&mut *stage)) {
+            v.resize(n, 0.0);
+        }
         self.b_rhs(sys, t, y, &mut k[0]);
         for (j, c) in [0.5, 0.5, 1.0].into_iter().enumerate() {
             for i in 0..n {
-                s[i] = y[i] + c * tau * k[j][i];
+                stage[i] = y[i] + c * tau * k[j][i];
             }
-            let mut kj = std::mem::take(&mut k[j + 1]);
-            self.b_rhs(sys, t + c * tau, &s, &mut kj);
-            k[j + 1] = kj;
+            self.b_rhs(sys, t + c * tau, stage, &mut k[j + 1]);
         }
         for i in 0..n {
             y[i] += tau / 6.0 * (k[0][i] + 2.0 * (k[1][i] + k[2][i]) + k[3][i]);
@@ -490,18 +500,26 @@ impl SplittingStepper {
         t: f64,
         h: f64,
         y: &mut [f64],
+        scratch: &mut RkScratch,
     ) -> Result<u64, String> {
         let mut evals = 0;
         let mut tt = t;
         for &g in &self.weights {
             let tau = g * h;
-            evals += self.flow_b(sys, tt, 0.5 * tau, y);
+            evals += self.flow_b(sys, tt, 0.5 * tau, y, scratch);
             self.flow_a(tau, y)?;
-            evals += self.flow_b(sys, tt + 0.5 * tau, 0.5 * tau, y);
+            evals += self.flow_b(sys, tt + 0.5 * tau, 0.5 * tau, y, scratch);
             tt += tau;
         }
         Ok(evals)
     }
+}
+
+/// Stage buffers of the RK4 sub-steps, kept across steps.
+#[derive(Debug, Clone, Default)]
+struct RkScratch {
+    k: [Vec<f64>; 4],
+    stage: Vec<f64>,
 }
 
 impl Stepper for SplittingStepper {
@@ -528,9 +546,10 @@ impl Stepper for SplittingStepper {
         let t = self.t;
         let h = t_next - t;
         let mut y = self.y.clone();
-        let evals = self
-            .compose(sys, t, h, &mut y)
-            .map_err(|what| StepError::SubFlow { t, what })?;
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let evals = self.compose(sys, t, h, &mut y, &mut scratch);
+        self.scratch = scratch;
+        let evals = evals.map_err(|what| StepError::SubFlow { t, what })?;
         self.free_flow = std::cell::OnceCell::new();
         self.y_prev = std::mem::replace(&mut self.y, y);
         std::mem::swap(&mut self.f_prev, &mut self.f_end);
