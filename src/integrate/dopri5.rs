@@ -237,13 +237,13 @@ impl Stepper for Dopri5 {
         let mut rejected_in_a_row = 0;
         let mut saw_non_finite = false;
         loop {
-            let h_wanted = self.h.min(self.h_max);
-            // Land exactly on t_end rather than leave a sliver of a step.
-            let last = h_wanted >= span * (1.0 - 1e-12);
-            let t_new = if last { t_end } else { self.t + h_wanted };
-            // The step is the difference of the two times, so steps add up to the times exactly.
-            let h = t_new - self.t;
-            if h.abs() <= 16.0 * f64::EPSILON * self.t.abs().max(1e-300) {
+            let super::StepEnd {
+                t_new,
+                h,
+                last,
+                underflow,
+            } = super::adaptive_step_end(self.t, self.h.min(self.h_max), t_end);
+            if underflow {
                 return Err(if saw_non_finite {
                     StepError::NonFiniteDerivative { t: self.t }
                 } else {

@@ -125,6 +125,34 @@ pub trait Stepper {
     fn stats(&self) -> Stats;
 }
 
+/// Where an adaptive step ends; see [`adaptive_step_end`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepEnd {
+    /// End time (s).
+    pub t_new: f64,
+    /// Step taken, `t_new − t` (s): steps add up to the times exactly.
+    pub h: f64,
+    /// The step was stretched or cut to land exactly on `t_end`.
+    pub last: bool,
+    /// `h` is below the resolution of `t` (step-size underflow).
+    pub underflow: bool,
+}
+
+/// Where an adaptive step of size `h_wanted` (s) from `t` ends: exactly on `t_end` when it
+/// would reach within 1e-12 of the remaining span (no sliver of a step is left), else at
+/// `t + h_wanted`.
+pub(crate) fn adaptive_step_end(t: f64, h_wanted: f64, t_end: f64) -> StepEnd {
+    let last = h_wanted >= (t_end - t) * (1.0 - 1e-12);
+    let t_new = if last { t_end } else { t + h_wanted };
+    let h = t_new - t;
+    StepEnd {
+        t_new,
+        h,
+        last,
+        underflow: h.abs() <= 16.0 * f64::EPSILON * t.abs().max(1e-300),
+    }
+}
+
 /// Tolerances of an adaptive method: the local error estimate of component `i` is kept below
 /// `atol + rtol·|y_i|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
