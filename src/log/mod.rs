@@ -18,7 +18,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{self, BufWriter};
+use std::io::{self, BufWriter, Write as _};
 use std::path::{Path, PathBuf};
 
 /// Frame names used in `/tf` and `/scene`.
@@ -26,7 +26,18 @@ pub const WORLD_FRAME: &str = "world";
 /// The body frame.
 pub const BODY_FRAME: &str = "body";
 
-/// Writes one run to an MCAP file.
+/// A file attached to an MCAP log.
+#[derive(Debug, Clone)]
+pub struct Attachment {
+    /// File name shown by readers.
+    pub name: String,
+    /// Media type, e.g. `application/json`.
+    pub media_type: String,
+    /// Contents.
+    pub data: Vec<u8>,
+}
+
+/// Writes one run (or several, under topic prefixes) to an MCAP file.
 pub struct McapLogger<'a> {
     spacecraft: &'a Spacecraft,
     /// `/effectors/<name>` channel of each effector, in order.
@@ -38,6 +49,8 @@ pub struct McapLogger<'a> {
     channels: Channels,
     sequence: u32,
     scene: SceneStyle,
+    /// Name of the body frame (`body`, or `<prefix>/body` when runs share a file).
+    body_frame: String,
     buf: Vec<u8>,
 }
 
@@ -84,6 +97,87 @@ struct SceneStyle {
     last: Option<f64>,
 }
 
+impl SceneStyle {
+    fn of(scenario: &Scenario, outcome_ref_omega: f64) -> Self {
+        let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
+        let size = match &scenario.shape {
+            Shape::Box { size, .. } => size.max(),
+            Shape::Cylinder { radius, length, .. } => length.max(2.0 * radius),
+        };
+        SceneStyle {
+            shape: scenario.shape.clone(),
+            arrow_length: 0.9 * size,
+            omega_ref: outcome_ref_omega.max(f64::MIN_POSITIVE),
+            h_ref: h0.max(f64::MIN_POSITIVE),
+            interval: 1.0 / scenario.scene_rate,
+            last: None,
+        }
+    }
+}
+
+/// The body frame's name for topics under `prefix`.
+fn body_frame(prefix: &str) -> String {
+    let p = prefix.trim_matches('/');
+    if p.is_empty() {
+        BODY_FRAME.to_string()
+    } else {
+        format!("{p}/{BODY_FRAME}")
+    }
+}
+
+/// Adds the schemas and channels of one run under `prefix`.
+fn register(
+    writer: &mut mcap::Writer<BufWriter<File>>,
+    scenario: &Scenario,
+    prefix: &str,
+) -> io::Result<(Channels, Vec<u16>)> {
+    let prefix = prefix.trim_end_matches('/');
+    let tf = add::<fg::FrameTransforms>(writer, &format!("{prefix}/tf"))?;
+    let scene = add::<fg::SceneUpdate>(writer, &format!("{prefix}/scene"))?;
+    let schema = telemetry::schema_bytes();
+    let tid = writer
+        .add_schema(telemetry::SCHEMA_NAME, "protobuf", &schema)
+        .map_err(io_err)?;
+    let telemetry = writer
+        .add_channel(
+            tid,
+            &format!("{prefix}/telemetry"),
+            "protobuf",
+            &BTreeMap::new(),
+        )
+        .map_err(io_err)?;
+    let log = add::<fg::Log>(writer, &format!("{prefix}/log"))?;
+    let mut effector_channels = Vec::new();
+    for e in scenario.spacecraft.effectors() {
+        let mut names = vec!["sim_time".to_string()];
+        names.extend(e.telemetry_names());
+        let message = message_name(e.name());
+        let schema = telemetry::schema_for("polhode.effectors", &message, &names);
+        let id = writer
+            .add_schema(&format!("polhode.effectors.{message}"), "protobuf", &schema)
+            .map_err(io_err)?;
+        effector_channels.push(
+            writer
+                .add_channel(
+                    id,
+                    &format!("{prefix}/effectors/{}", e.name()),
+                    "protobuf",
+                    &BTreeMap::from([("kind".to_string(), e.kind().to_string())]),
+                )
+                .map_err(io_err)?,
+        );
+    }
+    Ok((
+        Channels {
+            tf,
+            scene,
+            telemetry,
+            log,
+        },
+        effector_channels,
+    ))
+}
+
 fn io_err(e: mcap::McapError) -> io::Error {
     io::Error::other(e.to_string())
 }
@@ -113,6 +207,18 @@ impl<'a> McapLogger<'a> {
     /// Creates the temporary file next to `path` and writes the header, schemas and
     /// channels. Fails before any integration if the location is not writable.
     pub fn create(path: &Path, scenario: &'a Scenario, outcome_ref_omega: f64) -> io::Result<Self> {
+        Self::create_prefixed(path, scenario, outcome_ref_omega, "")
+    }
+
+    /// As [`McapLogger::create`], with every topic under `prefix` (e.g. `/worst`) and the
+    /// body frame named `<prefix>/body` without the leading slash, so several runs can share
+    /// one file ([`McapLogger::continue_with`]).
+    pub fn create_prefixed(
+        path: &Path,
+        scenario: &'a Scenario,
+        outcome_ref_omega: f64,
+        prefix: &str,
+    ) -> io::Result<Self> {
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -142,57 +248,10 @@ impl<'a> McapLogger<'a> {
             .compression_threads(0)
             .profile("")
             .library(format!("polhode {}", env!("CARGO_PKG_VERSION")));
-        let result = (|| {
-            let mut writer = options
-                .create(BufWriter::with_capacity(1 << 16, file))
-                .map_err(io_err)?;
-            let tf = add::<fg::FrameTransforms>(&mut writer, "/tf")?;
-            let scene = add::<fg::SceneUpdate>(&mut writer, "/scene")?;
-            let schema = telemetry::schema_bytes();
-            let tid = writer
-                .add_schema(telemetry::SCHEMA_NAME, "protobuf", &schema)
-                .map_err(io_err)?;
-            let telemetry = writer
-                .add_channel(tid, "/telemetry", "protobuf", &BTreeMap::new())
-                .map_err(io_err)?;
-            let log = add::<fg::Log>(&mut writer, "/log")?;
-            let mut effector_channels = Vec::new();
-            for e in scenario.spacecraft.effectors() {
-                let mut names = vec!["sim_time".to_string()];
-                names.extend(e.telemetry_names());
-                let message = message_name(e.name());
-                let schema = telemetry::schema_for("polhode.effectors", &message, &names);
-                let id = writer
-                    .add_schema(&format!("polhode.effectors.{message}"), "protobuf", &schema)
-                    .map_err(io_err)?;
-                effector_channels.push(
-                    writer
-                        .add_channel(
-                            id,
-                            &format!("/effectors/{}", e.name()),
-                            "protobuf",
-                            &BTreeMap::from([("kind".to_string(), e.kind().to_string())]),
-                        )
-                        .map_err(io_err)?,
-                );
-            }
-            Ok::<_, io::Error>((
-                writer,
-                Channels {
-                    tf,
-                    scene,
-                    telemetry,
-                    log,
-                },
-                effector_channels,
-            ))
-        })();
-        let (writer, channels, effector_channels) = result?;
-        let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
-        let size = match &scenario.shape {
-            Shape::Box { size, .. } => size.max(),
-            Shape::Cylinder { radius, length, .. } => length.max(2.0 * radius),
-        };
+        let mut writer = options
+            .create(BufWriter::with_capacity(1 << 16, file))
+            .map_err(io_err)?;
+        let (channels, effector_channels) = register(&mut writer, scenario, prefix)?;
         Ok(McapLogger {
             spacecraft: &scenario.spacecraft,
             effector_channels,
@@ -202,15 +261,41 @@ impl<'a> McapLogger<'a> {
             epoch_ns: scenario.epoch_unix_ns,
             channels,
             sequence: 0,
-            scene: SceneStyle {
-                shape: scenario.shape.clone(),
-                arrow_length: 0.9 * size,
-                omega_ref: outcome_ref_omega.max(f64::MIN_POSITIVE),
-                h_ref: h0.max(f64::MIN_POSITIVE),
-                interval: 1.0 / scenario.scene_rate,
-                last: None,
-            },
+            scene: SceneStyle::of(scenario, outcome_ref_omega),
+            body_frame: body_frame(prefix),
             buf: Vec::with_capacity(1024),
+        })
+    }
+
+    /// Registers the topics of another run (of `scenario`, under `prefix`) in the same file;
+    /// its samples follow those already written.
+    pub fn continue_with<'b>(
+        self,
+        scenario: &'b Scenario,
+        outcome_ref_omega: f64,
+        prefix: &str,
+    ) -> io::Result<McapLogger<'b>> {
+        let McapLogger {
+            mut writer,
+            temp,
+            final_path,
+            sequence,
+            buf,
+            ..
+        } = self;
+        let (channels, effector_channels) = register(&mut writer, scenario, prefix)?;
+        Ok(McapLogger {
+            spacecraft: &scenario.spacecraft,
+            effector_channels,
+            writer,
+            temp,
+            final_path,
+            epoch_ns: scenario.epoch_unix_ns,
+            channels,
+            sequence,
+            scene: SceneStyle::of(scenario, outcome_ref_omega),
+            body_frame: body_frame(prefix),
+            buf,
         })
     }
 
@@ -264,34 +349,16 @@ impl<'a> McapLogger<'a> {
         self.write(self.channels.log, t, &msg)
     }
 
-    /// Writes the run's metadata and the scenario attachment, finishes the file and renames
-    /// it to its final name.
+    /// Writes the run's end to `/log`, its metadata and the scenario attachment, finishes the
+    /// file and renames it to its final name.
     pub fn finish(
         mut self,
         scenario: &Scenario,
         method: &str,
         outcome: &Outcome,
     ) -> io::Result<PathBuf> {
+        self.end_run(outcome)?;
         let t_end = outcome.final_observation.t;
-        let level = match outcome.status {
-            crate::sim::Status::Completed | crate::sim::Status::Stopped { .. } => {
-                fg::log::Level::Info
-            }
-            _ => fg::log::Level::Warning,
-        };
-        let text = match &outcome.status {
-            crate::sim::Status::Completed => format!("run complete at t = {t_end} s"),
-            crate::sim::Status::Stopped { condition } => {
-                format!("run stopped at t = {t_end} s: {condition}")
-            }
-            crate::sim::Status::Interrupted => {
-                format!("run interrupted at t = {t_end} s; this log is partial")
-            }
-            crate::sim::Status::Failed { diagnosis } => {
-                format!("run failed; this log is partial: {diagnosis}")
-            }
-        };
-        self.log_text(t_end, level, &text)?;
         let mut meta = BTreeMap::new();
         meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
         meta.insert("scenario".into(), scenario.name.clone());
@@ -311,21 +378,63 @@ impl<'a> McapLogger<'a> {
             "rhs_evaluations".into(),
             outcome.stats.rhs_evaluations.to_string(),
         );
+        let attachment = Attachment {
+            name: "scenario.yaml".into(),
+            media_type: "application/yaml".into(),
+            data: scenario.source.as_bytes().to_vec(),
+        };
+        self.finish_with("polhode", meta, vec![attachment])
+    }
+
+    /// Writes how the current run ended to its `/log` topic.
+    pub fn end_run(&mut self, outcome: &Outcome) -> io::Result<()> {
+        let t_end = outcome.final_observation.t;
+        let level = match outcome.status {
+            crate::sim::Status::Completed | crate::sim::Status::Stopped { .. } => {
+                fg::log::Level::Info
+            }
+            _ => fg::log::Level::Warning,
+        };
+        let text = match &outcome.status {
+            crate::sim::Status::Completed => format!("run complete at t = {t_end} s"),
+            crate::sim::Status::Stopped { condition } => {
+                format!("run stopped at t = {t_end} s: {condition}")
+            }
+            crate::sim::Status::Interrupted => {
+                format!("run interrupted at t = {t_end} s; this log is partial")
+            }
+            crate::sim::Status::Failed { diagnosis } => {
+                format!("run failed; this log is partial: {diagnosis}")
+            }
+        };
+        self.log_text(t_end, level, &text)
+    }
+
+    /// Writes a metadata record `name` and `attachments` (stamped at the epoch), finishes the
+    /// file and renames it to its final name.
+    pub fn finish_with(
+        mut self,
+        name: &str,
+        metadata: BTreeMap<String, String>,
+        attachments: Vec<Attachment>,
+    ) -> io::Result<PathBuf> {
         self.writer
             .write_metadata(&mcap::records::Metadata {
-                name: "polhode".into(),
-                metadata: meta,
+                name: name.into(),
+                metadata,
             })
             .map_err(io_err)?;
-        self.writer
-            .attach(&mcap::Attachment {
-                log_time: self.epoch_ns,
-                create_time: self.epoch_ns,
-                name: "scenario.yaml".into(),
-                media_type: "application/yaml".into(),
-                data: Cow::Borrowed(scenario.source.as_bytes()),
-            })
-            .map_err(io_err)?;
+        for a in attachments {
+            self.writer
+                .attach(&mcap::Attachment {
+                    log_time: self.epoch_ns,
+                    create_time: self.epoch_ns,
+                    name: a.name,
+                    media_type: a.media_type,
+                    data: Cow::Owned(a.data),
+                })
+                .map_err(io_err)?;
+        }
         let McapLogger {
             mut writer,
             temp,
@@ -506,7 +615,7 @@ impl<'a> McapLogger<'a> {
             deletions: vec![],
             entities: vec![fg::SceneEntity {
                 timestamp: Some(self.timestamp(o.t)),
-                frame_id: BODY_FRAME.into(),
+                frame_id: self.body_frame.clone(),
                 id: "spacecraft".into(),
                 lifetime: None,
                 frame_locked: true,
@@ -534,7 +643,7 @@ impl Sink for McapLogger<'_> {
             transforms: vec![fg::FrameTransform {
                 timestamp: Some(self.timestamp(o.t)),
                 parent_frame_id: WORLD_FRAME.into(),
-                child_frame_id: BODY_FRAME.into(),
+                child_frame_id: self.body_frame.clone(),
                 translation: Some(fg::Vector3 {
                     x: 0.0,
                     y: 0.0,
@@ -588,4 +697,27 @@ impl Sink for McapLogger<'_> {
         );
         self.log_text(e.t, fg::log::Level::Info, &text)
     }
+}
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
 }
