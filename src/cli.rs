@@ -5,12 +5,12 @@
 //! kept, marked partial); 130 interrupted by Ctrl-C (the log is kept, marked partial).
 
 use crate::linearize::{Linearization, linearize, linearize_driven, spin_rate_of};
-use crate::log::McapLogger;
+use crate::log::{McapLogger, write_atomically};
 use crate::model::RigidBody;
 use crate::scenario::{self, Overrides, Scenario};
 use crate::sim::{self, Control, NullSink, Outcome, Status};
 use clap::{Parser, Subcommand};
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -87,6 +87,42 @@ enum Command {
     Bench {
         #[command(subcommand)]
         what: BenchCommand,
+    },
+    /// Run the scenario's Monte Carlo campaign (its `montecarlo:` block) on all cores.
+    Montecarlo {
+        /// Scenario YAML file with a `montecarlo:` block.
+        scenario: PathBuf,
+        /// Number of runs (overrides `montecarlo.runs`).
+        #[arg(long)]
+        runs: Option<u64>,
+        /// Seed of the random streams (overrides `montecarlo.seed`).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Run only shard K of N (`K/N`, 1-based): a contiguous slice of the runs, to be
+        /// combined with `polhode merge`.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+        /// Output directory (default `logs/<name>-montecarlo`, or `…/shard-K` for a shard).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Combine the outputs of all shards of a campaign into the result of the whole campaign.
+    Merge {
+        /// Shard output directories (one per shard).
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output directory for the combined result.
+        #[arg(long)]
+        out: PathBuf,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Eigenvalues of the linearisation about steady spin about the spin axis.
     Linearize {
@@ -240,6 +276,16 @@ pub fn main() -> i32 {
             duration,
         ),
         Command::Linearize { scenario, json } => linearize_cmd(&scenario, json.as_deref()),
+        Command::Montecarlo {
+            scenario,
+            runs,
+            seed,
+            threads,
+            shard,
+            out,
+            quiet,
+        } => montecarlo_cmd(&scenario, runs, seed, threads, shard.as_deref(), out, quiet),
+        Command::Merge { dirs, out, quiet } => merge_cmd(&dirs, &out, quiet),
         Command::Bench { what } => bench_cmd(what),
         Command::Run {
             scenario,
@@ -678,29 +724,6 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
-}
-
 /// Whether two paths name the same file (compared as absolute paths; neither need exist).
 fn same_file(a: &Path, b: &Path) -> bool {
     match (std::path::absolute(a), std::path::absolute(b)) {
@@ -1104,4 +1127,217 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     if let Some(p) = mcap {
         println!("  log: {}", p.display());
     }
+}
+
+/// Parses `K/N` (1 ≤ K ≤ N).
+fn parse_shard(text: &str) -> Result<[u64; 2], String> {
+    let bad = || format!("--shard {text}: expected K/N with 1 ≤ K ≤ N, e.g. 2/8");
+    let (k, n) = text.split_once('/').ok_or_else(bad)?;
+    let k: u64 = k.trim().parse().map_err(|_| bad())?;
+    let n: u64 = n.trim().parse().map_err(|_| bad())?;
+    if k == 0 || k > n {
+        return Err(bad());
+    }
+    Ok([k, n])
+}
+
+/// Running statistics shown on the progress bar.
+#[derive(Default)]
+struct CampaignProgress {
+    done: u64,
+    reached: u64,
+    time_sum: f64,
+    failed: u64,
+}
+
+fn montecarlo_cmd(
+    path: &Path,
+    runs: Option<u64>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    shard: Option<&str>,
+    out: Option<PathBuf>,
+    quiet: bool,
+) -> i32 {
+    use crate::montecarlo;
+    let prep = match montecarlo::load(path, runs, seed) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let shard = match shard.map(parse_shard).transpose() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if let Some([_, n]) = shard
+        && n > prep.campaign.runs
+    {
+        eprintln!(
+            "error: --shard: {n} shards for {} runs would leave some empty; use at most {} shards",
+            prep.campaign.runs, prep.campaign.runs
+        );
+        return EXIT_BAD_INPUT;
+    }
+    if threads == Some(0) {
+        eprintln!("error: --threads: expected at least 1");
+        return EXIT_BAD_INPUT;
+    }
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+    });
+    let range = match shard {
+        Some([k, n]) => montecarlo::shard_range(prep.campaign.runs, k, n),
+        None => 0..prep.campaign.runs,
+    };
+    let dir = out.unwrap_or_else(|| {
+        let base = PathBuf::from("logs").join(format!("{}-montecarlo", prep.scenario.name));
+        match shard {
+            Some([k, _]) => base.join(format!("shard-{k}")),
+            None => base,
+        }
+    });
+    if let Err(e) = std::fs::create_dir_all(&dir).and_then(|()| probe_writable(&dir.join("x"))) {
+        eprintln!("error: cannot write to {}: {e}", dir.display());
+        return EXIT_BAD_INPUT;
+    }
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                std::process::exit(EXIT_INTERRUPTED);
+            }
+        });
+    }
+    let total = range.end - range.start;
+    if !quiet {
+        eprintln!(
+            "{}: {} runs{} on {threads} thread(s), seed {} → {}",
+            prep.scenario.name,
+            total,
+            shard.map_or(String::new(), |[k, n]| format!(" (shard {k} of {n})")),
+            prep.campaign.seed,
+            dir.display()
+        );
+    }
+    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} runs, ETA {eta} | {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let stats = std::sync::Mutex::new(CampaignProgress::default());
+    let primary = prep.primary_event;
+    let on_row = |row: &crate::montecarlo::Row| {
+        let Ok(mut s) = stats.lock() else { return };
+        s.done += 1;
+        if !row.status.ok() {
+            s.failed += 1;
+        }
+        if let Some(t) = primary.and_then(|j| row.values[j]) {
+            s.reached += 1;
+            s.time_sum += t;
+        }
+        if let Some(b) = &bar {
+            b.inc(1);
+            let mean = if s.reached > 0 {
+                format!(", mean {:.1} min", s.time_sum / s.reached as f64 / 60.0)
+            } else {
+                String::new()
+            };
+            let flat = if primary.is_some() {
+                format!("flat spin in {}/{}{mean}; ", s.reached, s.done)
+            } else {
+                String::new()
+            };
+            b.set_message(format!("{flat}{} failed", s.failed));
+        }
+    };
+    let started = std::time::Instant::now();
+    let result = prep.execute(range, threads, &interrupt, &on_row);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let (rows, partial) = match result {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_IO;
+        }
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    if rows.is_empty() && partial {
+        eprintln!("interrupted before any run finished; nothing was written");
+        return EXIT_INTERRUPTED;
+    }
+    if let Err(e) = montecarlo::output::write_outputs(&dir, &prep, &rows, shard, partial) {
+        eprintln!("error: {e}");
+        return EXIT_IO;
+    }
+    if !quiet {
+        if let Ok(text) = std::fs::read_to_string(dir.join("summary.txt")) {
+            print!("{text}");
+        }
+        let memory =
+            peak_memory_mib().map_or(String::new(), |m| format!(", peak memory {m:.0} MiB"));
+        eprintln!(
+            "{} runs in {seconds:.2} s ({:.2} runs/s on {threads} thread(s){memory}) → {}",
+            rows.len(),
+            rows.len() as f64 / seconds.max(1e-9),
+            dir.display()
+        );
+    }
+    if partial {
+        eprintln!(
+            "interrupted: {} of {total} runs finished; the result in {} is marked partial",
+            rows.len(),
+            dir.display()
+        );
+        return EXIT_INTERRUPTED;
+    }
+    0
+}
+
+fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
+    use crate::montecarlo;
+    let (prep, rows) = match montecarlo::output::merge(dirs) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if let Err(e) = montecarlo::output::write_outputs(out, &prep, &rows, None, false) {
+        eprintln!("error: {e}");
+        return EXIT_IO;
+    }
+    if !quiet {
+        if let Ok(text) = std::fs::read_to_string(out.join("summary.txt")) {
+            print!("{text}");
+        }
+        eprintln!(
+            "merged {} shards ({} runs) → {}",
+            dirs.len(),
+            rows.len(),
+            out.display()
+        );
+    }
+    0
+}
+
+/// Peak resident memory of this process (MiB), from Linux's `/proc/self/status` (`VmHWM`).
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
 }

@@ -18,6 +18,7 @@ pub mod integrate;
 pub mod linearize;
 pub mod log;
 pub mod model;
+pub mod montecarlo;
 pub mod plot;
 pub mod scenario;
 pub mod sim;

@@ -64,6 +64,9 @@ pub struct ScenarioFile {
     /// A prescribed hub rotation (the hub's centre of mass is then pinned).
     #[serde(default)]
     pub hub_motion: Option<HubMotionSpec>,
+    /// A Monte Carlo campaign over this scenario (`polhode montecarlo`; ignored by `run`).
+    #[serde(default)]
+    pub montecarlo: Option<crate::montecarlo::CampaignFile>,
 }
 
 /// `body:` mass properties and display.
@@ -492,6 +495,8 @@ pub struct Scenario {
     pub events: Vec<Condition>,
     /// Shape for viewers.
     pub shape: Shape,
+    /// The `montecarlo:` block as written, checked by `montecarlo::Campaign::new`.
+    pub montecarlo: Option<crate::montecarlo::CampaignFile>,
 }
 
 /// Overrides from the command line, applied before validation.
@@ -630,7 +635,7 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
     ScenarioError::at(path, location, field, message)
 }
 
-fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
+pub(crate) fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
     Some((s.referenced.line() as u32, s.referenced.column() as u32))
 }
 
@@ -1236,6 +1241,7 @@ impl ScenarioFile {
             stop,
             events,
             shape,
+            montecarlo: self.montecarlo,
         })
     }
 }

@@ -1,0 +1,406 @@
+//! Monte Carlo campaigns over perturbed scenarios (`polhode montecarlo`, `polhode merge`;
+//! documented in `docs/montecarlo.md` and `docs/cluster.md`).
+//!
+//! Run i draws from the ChaCha8 stream (seed, i): its draws depend on nothing else, so a
+//! campaign gives the same table whatever the thread count, the order of the runs or the way
+//! it is split into shards. Runs are independent and single-threaded; rayon spreads them over
+//! the cores. Only the per-run table is kept in memory.
+
+mod dispersion;
+pub mod output;
+mod spec;
+mod summary;
+pub mod table;
+
+pub use dispersion::{Dispersion, Distribution, Target, erfc, normal_mass};
+pub use spec::{Campaign, CampaignFile, MAX_RUNS};
+pub use summary::{percentile, wilson95};
+pub use table::{Row, RunStatus};
+
+use crate::log::telemetry;
+use crate::model::Observation;
+use crate::scenario::{self, Overrides, Quantity, Scenario, ScenarioError};
+use crate::sim::{self, Control, EventRecord, Reference, Sink, Status};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+use std::ops::Range;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A campaign ready to run: the nominal scenario, its tree, the checked campaign and the
+/// table's columns.
+#[derive(Debug)]
+pub struct Prepared {
+    /// The nominal scenario.
+    pub scenario: Scenario,
+    /// The campaign settings.
+    pub campaign: Campaign,
+    /// The scenario as a JSON tree without its `montecarlo` block.
+    tree: Value,
+    /// Columns after `run`, `status`, `message`.
+    pub columns: Vec<String>,
+    /// Hex SHA-256 of the scenario file's text.
+    pub scenario_sha256: String,
+    /// The scenario file as named on the command line (recorded, and used in messages).
+    pub scenario_file: String,
+    /// Column of the event that stands for the flat spin (charts, ranking), if any.
+    pub primary_event: Option<usize>,
+    /// Column of the initial transverse rate.
+    pub transverse_column: usize,
+    /// The conditions of the event columns.
+    pub event_conditions: Vec<String>,
+    /// First event column.
+    event_start: usize,
+    /// Column of the largest nutation.
+    max_nutation_column: usize,
+}
+
+/// Hex SHA-256 of `bytes`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// A column name made of letters, digits and `_`.
+fn identifier(s: &str) -> String {
+    let mut out = String::new();
+    for c in s.chars() {
+        if c.is_ascii_alphanumeric() {
+            out.push(c);
+        } else if c == '.' || c == '-' {
+            out.push(if c == '-' { 'm' } else { 'p' });
+        } else if !out.ends_with('_') {
+            out.push('_');
+        }
+    }
+    out.trim_end_matches('_').to_string()
+}
+
+impl Prepared {
+    /// Checks the `montecarlo:` block of `scenario` (loaded from `scenario_file`) and lays out
+    /// the table. `runs` and `seed` override the block's values.
+    pub fn new(
+        scenario: Scenario,
+        scenario_file: &str,
+        runs: Option<u64>,
+        seed: Option<u64>,
+    ) -> Result<Self, ScenarioError> {
+        let path = scenario.path.clone();
+        let Some(file) = &scenario.montecarlo else {
+            return Err(ScenarioError::whole_file(
+                &path,
+                "expected a `montecarlo:` block with `runs` and `dispersions` (see \
+                 docs/montecarlo.md)",
+            ));
+        };
+        let mut tree: Value = serde_saphyr::from_str(&scenario.source).map_err(|e| {
+            ScenarioError::whole_file(&path, format!("cannot read the YAML as a tree: {e}"))
+        })?;
+        if let Some(map) = tree.as_object_mut() {
+            map.remove("montecarlo");
+        }
+        let mut campaign = Campaign::new(&path, file, &tree, scenario.duration)?;
+        if let Some(r) = runs {
+            if r == 0 || r > MAX_RUNS {
+                return Err(ScenarioError::whole_file(
+                    &path,
+                    format!("--runs: expected 1 to {MAX_RUNS}, got {r}"),
+                ));
+            }
+            campaign.runs = r;
+        }
+        if let Some(s) = seed {
+            campaign.seed = s;
+        }
+        // Each perturbed field must take a continuous value: the nominal value written as a
+        // floating-point number (4 → 4.0) must still load; a count or a stage number fails.
+        for (k, d) in campaign.dispersions.iter().enumerate() {
+            if let Target::Path(p) = &d.target {
+                let mut probe = tree.clone();
+                let x0 = p.nominal(&probe);
+                let as_float: Vec<Value> = x0.iter().map(|x| serde_json::json!(x)).collect();
+                if let Some(slot) = probe.pointer_mut(&p.pointer) {
+                    *slot = if p.is_list {
+                        Value::Array(as_float)
+                    } else {
+                        as_float[0].clone()
+                    };
+                }
+                let text = serde_json::to_string(&probe).unwrap_or_default();
+                if let Err(e) = scenario::parse(&path, text, &Overrides::default()) {
+                    return Err(ScenarioError::at(
+                        &path,
+                        d.at,
+                        format!("montecarlo.dispersions[{k}].path"),
+                        format!(
+                            "`{}` does not take a continuous value ({}), so it \
+                             cannot be dispersed",
+                            d.label, e.message
+                        ),
+                    ));
+                }
+            }
+        }
+        // A field perturbed twice (a tilt, then a magnitude) records the value after each;
+        // the later columns are told apart by `@k`, k the dispersion's index.
+        let mut columns: Vec<String> = Vec::new();
+        for (k, d) in campaign.dispersions.iter().enumerate() {
+            for c in d.columns() {
+                if columns.contains(&c) {
+                    columns.push(format!("{c}@{k}"));
+                } else {
+                    columns.push(c);
+                }
+            }
+        }
+        let transverse_column = columns.len();
+        columns.push("initial_transverse_rate".into());
+        let event_start = columns.len();
+        let event_conditions: Vec<String> = scenario.events.iter().map(|c| c.describe()).collect();
+        for c in &event_conditions {
+            columns.push(format!("t_{}", identifier(c)));
+        }
+        let max_nutation_column = columns.len() + 1;
+        columns.extend(
+            [
+                "final_nutation_deg",
+                "max_nutation_deg",
+                "final_spin_axis_x",
+                "final_spin_axis_y",
+                "final_spin_axis_z",
+                "kinetic_energy_lost",
+                "energy_dissipated",
+            ]
+            .map(String::from),
+        );
+        for &f in &campaign.final_telemetry {
+            columns.push(format!("final_{}", telemetry::FIELDS[f]));
+        }
+        columns.extend(["end_time", "steps", "rhs_evaluations"].map(String::from));
+        let mut seen = std::collections::BTreeSet::new();
+        for c in &columns {
+            if !seen.insert(c.as_str()) {
+                return Err(ScenarioError::whole_file(
+                    &path,
+                    format!(
+                        "montecarlo: two table columns would be named `{c}`; a dispersion \
+                         path must not be named like a metric column"
+                    ),
+                ));
+            }
+        }
+        // The flat spin: the nutation event with the highest `above` threshold.
+        let primary_event = scenario
+            .events
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.quantity == Quantity::NutationAngleDeg && c.above)
+            .max_by(|a, b| a.1.threshold.total_cmp(&b.1.threshold))
+            .map(|(k, _)| event_start + k);
+        Ok(Prepared {
+            scenario_sha256: sha256_hex(scenario.source.as_bytes()),
+            scenario_file: scenario_file.to_string(),
+            scenario,
+            campaign,
+            tree,
+            columns,
+            primary_event,
+            transverse_column,
+            event_conditions,
+            event_start,
+            max_nutation_column,
+        })
+    }
+
+    /// The random stream of run `i`: ChaCha8 seeded with the campaign seed, stream `i`.
+    pub fn stream(&self, i: u64) -> ChaCha8Rng {
+        let mut rng = ChaCha8Rng::seed_from_u64(self.campaign.seed);
+        rng.set_stream(i);
+        rng
+    }
+
+    /// The perturbed scenario of run `i` and the recorded inputs (`Err`: why the draw is not
+    /// a valid scenario).
+    pub fn build_run(&self, i: u64) -> Result<(Scenario, Vec<f64>), String> {
+        let mut rng = self.stream(i);
+        let mut tree = self.tree.clone();
+        let mut inputs = Vec::new();
+        for d in &self.campaign.dispersions {
+            d.apply(&mut tree, &mut rng, &mut inputs)?;
+        }
+        let text = serde_json::to_string(&tree).map_err(|e| e.to_string())?;
+        let mut sc = scenario::parse(&self.scenario.path, text, &Overrides::default())
+            .map_err(|e| format!("the perturbed scenario is not valid: {}", e.message))?;
+        sc.path = self.scenario_file.clone().into();
+        Ok((sc, inputs))
+    }
+
+    /// Runs `i` to the end; `None` if it was interrupted (it is then not part of the result).
+    pub fn run_one(&self, i: u64, interrupt: &AtomicBool) -> Option<Row> {
+        let mut values = vec![None; self.columns.len()];
+        let (sc, inputs) = match self.build_run(i) {
+            Ok(x) => x,
+            Err(message) => {
+                return Some(Row {
+                    run: i,
+                    status: RunStatus::Invalid,
+                    message,
+                    values,
+                });
+            }
+        };
+        for (k, v) in inputs.iter().enumerate() {
+            values[k] = Some(*v);
+        }
+        let s = sc.spacecraft.spin_axis.normalize();
+        let w = sc.omega0;
+        values[self.transverse_column] = Some((w - s * w.dot(&s)).norm());
+        let mut sink = Extremes::default();
+        let ctl = Control {
+            interrupt,
+            progress: None,
+        };
+        let outcome = match sim::run(&sc, &mut sink, ctl) {
+            Ok(o) => o,
+            Err(e) => {
+                return Some(Row {
+                    run: i,
+                    status: RunStatus::Failed,
+                    message: e.to_string(),
+                    values,
+                });
+            }
+        };
+        let (status, message) = match &outcome.status {
+            Status::Completed => (RunStatus::Complete, String::new()),
+            Status::Stopped { condition } => (RunStatus::Stopped, condition.clone()),
+            Status::Interrupted => return None,
+            Status::Failed { diagnosis } => (RunStatus::Failed, diagnosis.clone()),
+        };
+        for (k, c) in self.event_conditions.iter().enumerate() {
+            values[self.event_start + k] = outcome
+                .events
+                .iter()
+                .find(|e| &e.condition == c)
+                .map(|e| e.t);
+        }
+        let o = &outcome.final_observation;
+        let o0 = &outcome.initial_observation;
+        let axis = o.omega.try_normalize(0.0).unwrap_or_default();
+        let mut at = self.max_nutation_column - 1;
+        for v in [
+            o.nutation_angle.to_degrees(),
+            sink.max_nutation.max(o.nutation_angle).to_degrees(),
+            axis[0],
+            axis[1],
+            axis[2],
+            o0.kinetic_energy - o.kinetic_energy,
+            o.dissipated_energy,
+        ] {
+            values[at] = Some(v);
+            at += 1;
+        }
+        let tel = telemetry::values(o, &Reference::of(o0));
+        for &f in &self.campaign.final_telemetry {
+            values[at] = Some(tel[f]);
+            at += 1;
+        }
+        values[at] = Some(o.t);
+        values[at + 1] = Some(outcome.stats.steps as f64);
+        values[at + 2] = Some(outcome.stats.rhs_evaluations as f64);
+        Some(Row {
+            run: i,
+            status,
+            message,
+            values,
+        })
+    }
+
+    /// Runs `range` on `threads` threads. Calls `on_row` as each run finishes (from any
+    /// thread). Returns the finished runs in run order and whether any run was skipped or cut
+    /// short by `interrupt`.
+    pub fn execute(
+        &self,
+        range: Range<u64>,
+        threads: usize,
+        interrupt: &AtomicBool,
+        on_row: &(dyn Fn(&Row) + Sync),
+    ) -> Result<(Vec<Row>, bool), String> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.max(1))
+            .build()
+            .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
+        let results: Vec<Option<Row>> = pool.install(|| {
+            range
+                .into_par_iter()
+                .map(|i| {
+                    if interrupt.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let row = self.run_one(i, interrupt)?;
+                    on_row(&row);
+                    Some(row)
+                })
+                .collect()
+        });
+        let partial = results.iter().any(Option::is_none);
+        Ok((results.into_iter().flatten().collect(), partial))
+    }
+
+    /// How runs are ranked: by the flat-spin event time (earliest is worst) or, without
+    /// such an event, by the largest nutation (largest is worst).
+    pub fn rank_rule(&self) -> summary::RankRule {
+        match self.primary_event {
+            Some(c) => summary::RankRule {
+                column: c,
+                name: self.columns[c].clone(),
+                smaller_is_worse: true,
+                missing: f64::INFINITY,
+            },
+            None => summary::RankRule {
+                column: self.max_nutation_column,
+                name: self.columns[self.max_nutation_column].clone(),
+                smaller_is_worse: false,
+                missing: f64::NEG_INFINITY,
+            },
+        }
+    }
+}
+
+/// Loads a scenario and prepares its campaign.
+pub fn load(path: &Path, runs: Option<u64>, seed: Option<u64>) -> Result<Prepared, ScenarioError> {
+    let sc = scenario::load(path, &Overrides::default())?;
+    Prepared::new(sc, &path.display().to_string(), runs, seed)
+}
+
+/// The run range of shard `k` of `n` (1-based) of `runs` runs: contiguous, sizes differing by
+/// at most one.
+pub fn shard_range(runs: u64, k: u64, n: u64) -> Range<u64> {
+    let at = |j: u64| ((u128::from(runs) * u128::from(j)) / u128::from(n)) as u64;
+    at(k - 1)..at(k)
+}
+
+/// Tracks the largest nutation angle seen (rad) at output samples and events.
+#[derive(Debug, Default)]
+struct Extremes {
+    max_nutation: f64,
+}
+
+impl Sink for Extremes {
+    fn sample(&mut self, o: &Observation, _: &[f64], _: &Reference) -> std::io::Result<()> {
+        self.max_nutation = self.max_nutation.max(o.nutation_angle);
+        Ok(())
+    }
+    fn event(&mut self, _: &EventRecord, o: &Observation) -> std::io::Result<()> {
+        self.max_nutation = self.max_nutation.max(o.nutation_angle);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;

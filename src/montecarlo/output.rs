@@ -1,0 +1,587 @@
+//! What a campaign writes into its directory, and `merge`, which checks shard outputs and
+//! writes the combined result.
+//!
+//! Files: `runs.csv`, `runs.parquet`, `summary.json`, `summary.txt`, `scenario.yaml` (the
+//! scenario as given), and for a whole campaign (not a shard) the charts and
+//! `campaign.mcap`. `campaign.json`, the manifest, is written last: a directory without it
+//! holds no finished result. Every file is written under a temporary name and renamed.
+
+use super::summary::{self, ColumnStats, EventStats, Failure, Ranking, StatusCounts};
+use super::table::{self, Row};
+use super::{Prepared, sha256_hex, shard_range};
+use crate::log::{Attachment, McapLogger, write_atomically};
+use crate::plot::{Chart, Series, Style};
+use crate::scenario::{self, Overrides};
+use crate::sim::{self, Control};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// Format tag of `campaign.json`.
+pub const MANIFEST_FORMAT: &str = "polhode-campaign/1";
+
+/// `campaign.json`: what was run, so that shards can be checked against each other.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Manifest {
+    /// [`MANIFEST_FORMAT`].
+    pub format: String,
+    /// polhode version that wrote it.
+    pub polhode_version: String,
+    /// Scenario `name:`.
+    pub scenario: String,
+    /// Scenario file as named on the command line.
+    pub scenario_file: String,
+    /// Hex SHA-256 of the scenario text.
+    pub scenario_sha256: String,
+    /// Campaign seed.
+    pub seed: u64,
+    /// Runs in the whole campaign.
+    pub runs: u64,
+    /// `[k, n]` for shard k of n (1-based); absent for a whole campaign.
+    pub shard: Option<[u64; 2]>,
+    /// Run indices this output covers, `[start, end)`.
+    pub run_range: [u64; 2],
+    /// Rows in `runs.csv`.
+    pub runs_in_table: u64,
+    /// Whether runs of the range are missing (interrupted).
+    pub partial: bool,
+    /// Columns after `run`, `status`, `message`.
+    pub columns: Vec<String>,
+    /// Hex SHA-256 of `runs.csv`.
+    pub runs_csv_sha256: String,
+}
+
+/// `summary.json`.
+#[derive(Debug, Serialize)]
+struct SummaryDoc<'a> {
+    format: &'static str,
+    polhode_version: &'a str,
+    scenario: &'a str,
+    scenario_sha256: &'a str,
+    seed: u64,
+    runs: u64,
+    shard: Option<[u64; 2]>,
+    run_range: [u64; 2],
+    runs_in_table: u64,
+    partial: bool,
+    status: StatusCounts,
+    percentiles: &'static [f64],
+    events: Vec<EventStats>,
+    ranking: Option<Ranking>,
+    columns: Vec<ColumnStats>,
+    failures: Vec<Failure>,
+}
+
+/// Writes every output of `rows` (the runs of `range` that finished) into `dir`.
+/// `whole` adds the charts and the MCAP of the worst, median and best runs.
+pub fn write_outputs(
+    dir: &Path,
+    prep: &Prepared,
+    rows: &[Row],
+    shard: Option<[u64; 2]>,
+    partial: bool,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let range = match shard {
+        Some([k, n]) => shard_range(prep.campaign.runs, k, n),
+        None => 0..prep.campaign.runs,
+    };
+    let mut written = Vec::new();
+    let put = |written: &mut Vec<PathBuf>, name: &str, bytes: &[u8]| -> Result<(), String> {
+        let p = dir.join(name);
+        write_atomically(&p, bytes).map_err(|e| format!("cannot write {}: {e}", p.display()))?;
+        written.push(p);
+        Ok(())
+    };
+    let csv = table::to_csv(&prep.columns, rows);
+    put(&mut written, "runs.csv", csv.as_bytes())?;
+    put(
+        &mut written,
+        "runs.parquet",
+        &table::to_parquet(&prep.columns, rows)?,
+    )?;
+    put(
+        &mut written,
+        "scenario.yaml",
+        prep.scenario.source.as_bytes(),
+    )?;
+    let manifest = Manifest {
+        format: MANIFEST_FORMAT.into(),
+        polhode_version: env!("CARGO_PKG_VERSION").into(),
+        scenario: prep.scenario.name.clone(),
+        scenario_file: prep.scenario_file.clone(),
+        scenario_sha256: prep.scenario_sha256.clone(),
+        seed: prep.campaign.seed,
+        runs: prep.campaign.runs,
+        shard,
+        run_range: [range.start, range.end],
+        runs_in_table: rows.len() as u64,
+        partial,
+        columns: prep.columns.clone(),
+        runs_csv_sha256: sha256_hex(csv.as_bytes()),
+    };
+    let doc = summary_doc(prep, rows, &manifest);
+    let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
+    put(&mut written, "summary.json", json.as_bytes())?;
+    put(
+        &mut written,
+        "summary.txt",
+        summary_text(prep, &doc).as_bytes(),
+    )?;
+    if shard.is_none() {
+        written.extend(charts(dir, prep, rows)?);
+        if let Some(r) = &doc.ranking
+            && let Some(p) = trajectories(dir, prep, r, &json)?
+        {
+            written.push(p);
+        }
+    }
+    let m = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
+    put(&mut written, "campaign.json", m.as_bytes())?;
+    Ok(written)
+}
+
+fn summary_doc<'a>(prep: &'a Prepared, rows: &[Row], m: &'a Manifest) -> SummaryDoc<'a> {
+    let events = prep
+        .event_conditions
+        .iter()
+        .enumerate()
+        .map(|(k, c)| {
+            let j = prep.event_start + k;
+            summary::event_stats(c, &prep.columns[j], j, rows, &prep.campaign.probability_by)
+        })
+        .collect();
+    let columns = prep
+        .columns
+        .iter()
+        .enumerate()
+        .filter_map(|(j, c)| summary::column_stats(c, j, rows))
+        .collect();
+    SummaryDoc {
+        format: "polhode-campaign-summary/1",
+        polhode_version: &m.polhode_version,
+        scenario: &m.scenario,
+        scenario_sha256: &m.scenario_sha256,
+        seed: m.seed,
+        runs: m.runs,
+        shard: m.shard,
+        run_range: m.run_range,
+        runs_in_table: m.runs_in_table,
+        partial: m.partial,
+        status: summary::status_counts(rows),
+        percentiles: &summary::PERCENTILES,
+        events,
+        ranking: summary::rank(rows, &prep.rank_rule()),
+        columns,
+        failures: summary::failures(rows),
+    }
+}
+
+fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
+    let mut out = String::new();
+    let f = summary::fmt;
+    let _ = writeln!(
+        out,
+        "polhode {} Monte Carlo campaign: {} (seed {}, {} runs)",
+        d.polhode_version, d.scenario, d.seed, d.runs
+    );
+    if let Some([k, n]) = d.shard {
+        let _ = writeln!(
+            out,
+            "shard {k} of {n}: runs {} to {}",
+            d.run_range[0],
+            d.run_range[1].saturating_sub(1)
+        );
+    }
+    if d.partial {
+        let _ = writeln!(
+            out,
+            "PARTIAL: interrupted; {} of the {} runs of this range finished",
+            d.runs_in_table,
+            d.run_range[1] - d.run_range[0]
+        );
+    }
+    let s = &d.status;
+    let _ = writeln!(
+        out,
+        "runs: {} complete, {} stopped, {} failed, {} invalid",
+        s.complete, s.stopped, s.failed, s.invalid
+    );
+    for e in &d.events {
+        let _ = writeln!(
+            out,
+            "\nevent `{}`: reached in {} of {} usable runs",
+            e.condition, e.reached, e.runs
+        );
+        for b in &e.by {
+            let _ = writeln!(
+                out,
+                "  by t = {} s: P = {} (95% CI {} to {}; {} runs)",
+                f(b.t),
+                f(b.probability),
+                f(b.ci95[0]),
+                f(b.ci95[1]),
+                b.count
+            );
+        }
+    }
+    if let Some(r) = &d.ranking {
+        let _ = writeln!(
+            out,
+            "\nranked by {} ({} is worst): worst run {}, median run {}, best run {}",
+            r.by, r.worst_is, r.worst, r.median, r.best
+        );
+    }
+    let _ = writeln!(out, "\n{}", summary::stats_table(&d.columns));
+    if !d.failures.is_empty() {
+        let _ = writeln!(
+            out,
+            "failed or invalid runs (first {}):",
+            summary::LISTED_FAILURES
+        );
+        for x in &d.failures {
+            let _ = writeln!(out, "  run {} ({}): {}", x.run, x.status, x.message);
+        }
+    }
+    let _ = prep;
+    out
+}
+
+/// Histogram and CDF of the flat-spin time, and initial transverse rate against it.
+fn charts(dir: &Path, prep: &Prepared, rows: &[Row]) -> Result<Vec<PathBuf>, String> {
+    let Some(j) = prep.primary_event else {
+        return Ok(vec![]);
+    };
+    let usable: Vec<&Row> = rows.iter().filter(|r| r.status.ok()).collect();
+    let mut times: Vec<f64> = usable.iter().filter_map(|r| r.values[j]).collect();
+    if times.is_empty() {
+        return Ok(vec![]);
+    }
+    times.sort_by(f64::total_cmp);
+    let condition = &prep.event_conditions[j - prep.event_start];
+    let n = usable.len();
+    let reached = times.len();
+    let minutes = |t: f64| t / 60.0;
+    let mut out = Vec::new();
+
+    // Histogram: bins by the Freedman–Diaconis rule, 10 to 60 of them.
+    let (lo, hi) = (times[0], times[reached - 1]);
+    let iqr = summary::percentile(&times, 75.0) - summary::percentile(&times, 25.0);
+    let width = 2.0 * iqr / (reached as f64).cbrt();
+    let bins = if width > 0.0 && hi > lo {
+        (((hi - lo) / width).ceil() as usize).clamp(10, 60)
+    } else {
+        10
+    };
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    let mut counts = vec![0usize; bins];
+    for t in &times {
+        let b = (((t - lo) / span) * bins as f64).floor() as usize;
+        counts[b.min(bins - 1)] += 1;
+    }
+    let mut outline = vec![(minutes(lo), 0.0)];
+    for (b, c) in counts.iter().enumerate() {
+        let x0 = minutes(lo + span * b as f64 / bins as f64);
+        let x1 = minutes(lo + span * (b + 1) as f64 / bins as f64);
+        outline.push((x0, *c as f64));
+        outline.push((x1, *c as f64));
+    }
+    outline.push((minutes(lo + span), 0.0));
+    let mut h = Chart::new(
+        format!("Time to flat spin ({condition}): {reached} of {n} runs"),
+        "time (min)",
+        "runs per bin",
+    );
+    h.x_range = Some((minutes(lo - 0.05 * span), minutes(hi + 0.05 * span)));
+    let tallest = counts.iter().copied().max().unwrap_or(1) as f64;
+    h.y_range = Some((0.0, 1.1 * tallest));
+    h.series.push(Series::new("", outline, Style::Line));
+    out.extend(chart_files(&h, dir, "flat_spin_time_histogram")?);
+
+    // CDF over all usable runs: it ends below 1 when some runs never reach the event.
+    // From t = 0 to the end of the scenario, so both ends of the staircase are visible.
+    let mut cdf = vec![(0.0, 0.0)];
+    for (k, t) in times.iter().enumerate() {
+        cdf.push((minutes(*t), k as f64 / n as f64));
+        cdf.push((minutes(*t), (k + 1) as f64 / n as f64));
+    }
+    cdf.push((
+        minutes(prep.scenario.duration.max(hi)),
+        reached as f64 / n as f64,
+    ));
+    let mut c = Chart::new(
+        format!("Probability of a flat spin ({condition}) by time"),
+        "time (min)",
+        "fraction of runs",
+    );
+    c.y_range = Some((0.0, 1.05));
+    c.series.push(Series::new("", cdf, Style::Line));
+    out.extend(chart_files(&c, dir, "flat_spin_time_cdf")?);
+
+    // Scatter.
+    let points: Vec<(f64, f64)> = usable
+        .iter()
+        .filter_map(|r| Some((r.values[prep.transverse_column]?, minutes(r.values[j]?))))
+        .collect();
+    let mut s = Chart::new(
+        "Initial transverse rate against time to flat spin",
+        "initial transverse rate (rad/s)",
+        "time to flat spin (min)",
+    );
+    s.series.push(Series::new("", points, Style::Markers));
+    out.extend(chart_files(&s, dir, "transverse_rate_vs_flat_spin_time")?);
+    Ok(out)
+}
+
+fn chart_files(chart: &Chart, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, String> {
+    let svg = chart.to_svg(900, 600);
+    let svg_path = dir.join(format!("{stem}.svg"));
+    write_atomically(&svg_path, svg.as_bytes())
+        .map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
+    let png_path = dir.join(format!("{stem}.png"));
+    let tmp = dir.join(format!(".{stem}.{}.png.tmp", std::process::id()));
+    let result = crate::plot::write_png(&svg, &tmp)
+        .and_then(|()| std::fs::rename(&tmp, &png_path).map_err(|e| e.to_string()));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("cannot write {}: {e}", png_path.display()));
+    }
+    Ok(vec![svg_path, png_path])
+}
+
+/// `campaign.mcap`: the worst, median and best runs re-run with full logging under
+/// `/worst`, `/median`, `/best`, with the summary attached.
+fn trajectories(
+    dir: &Path,
+    prep: &Prepared,
+    ranking: &Ranking,
+    summary_json: &str,
+) -> Result<Option<PathBuf>, String> {
+    let picks = [
+        ("worst", ranking.worst),
+        ("median", ranking.median),
+        ("best", ranking.best),
+    ];
+    let mut scenarios = Vec::new();
+    for (_, i) in picks {
+        scenarios.push(prep.build_run(i).map_err(|e| format!("run {i}: {e}"))?.0);
+    }
+    let path = dir.join("campaign.mcap");
+    let never = AtomicBool::new(false);
+    let mut logger: Option<McapLogger> = None;
+    let mut meta = BTreeMap::new();
+    let mut attachments = Vec::new();
+    for ((label, i), sc) in picks.iter().zip(&scenarios) {
+        let prefix = format!("/{label}");
+        let mut l = match logger.take() {
+            None => McapLogger::create_prefixed(&path, sc, sc.omega0.norm(), &prefix),
+            Some(prev) => prev.continue_with(sc, sc.omega0.norm(), &prefix),
+        }
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        let outcome = sim::run(
+            sc,
+            &mut l,
+            Control {
+                interrupt: &never,
+                progress: None,
+            },
+        )
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        l.end_run(&outcome)
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        meta.insert(format!("{label}_run"), i.to_string());
+        meta.insert(
+            format!("{label}_status"),
+            outcome.status.label().to_string(),
+        );
+        attachments.push(Attachment {
+            name: format!("{label}.scenario.json"),
+            media_type: "application/json".into(),
+            data: sc.source.as_bytes().to_vec(),
+        });
+        logger = Some(l);
+    }
+    let Some(l) = logger else { return Ok(None) };
+    meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
+    meta.insert("scenario".into(), prep.scenario.name.clone());
+    meta.insert("seed".into(), prep.campaign.seed.to_string());
+    meta.insert("runs".into(), prep.campaign.runs.to_string());
+    meta.insert("ranked_by".into(), ranking.by.clone());
+    attachments.push(Attachment {
+        name: "summary.json".into(),
+        media_type: "application/json".into(),
+        data: summary_json.as_bytes().to_vec(),
+    });
+    attachments.push(Attachment {
+        name: "scenario.yaml".into(),
+        media_type: "application/yaml".into(),
+        data: prep.scenario.source.as_bytes().to_vec(),
+    });
+    l.finish_with("polhode_campaign", meta, attachments)
+        .map(Some)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// One shard output read back for `merge`.
+struct ShardOutput {
+    dir: PathBuf,
+    manifest: Manifest,
+    csv: String,
+    scenario: String,
+}
+
+fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
+    let d = dir.display();
+    let manifest_text = std::fs::read_to_string(dir.join("campaign.json"))
+        .map_err(|e| format!("{d}: no finished campaign output here (campaign.json: {e})"))?;
+    let manifest: Manifest = serde_json::from_str(&manifest_text)
+        .map_err(|e| format!("{d}/campaign.json is not a polhode campaign manifest: {e}"))?;
+    if manifest.format != MANIFEST_FORMAT {
+        return Err(format!(
+            "{d}/campaign.json has format `{}`; expected `{MANIFEST_FORMAT}`",
+            manifest.format
+        ));
+    }
+    let csv =
+        std::fs::read_to_string(dir.join("runs.csv")).map_err(|e| format!("{d}/runs.csv: {e}"))?;
+    if sha256_hex(csv.as_bytes()) != manifest.runs_csv_sha256 {
+        return Err(format!(
+            "{d}/runs.csv does not match its manifest (truncated or altered after it was \
+             written); re-run this shard"
+        ));
+    }
+    let scenario = std::fs::read_to_string(dir.join("scenario.yaml"))
+        .map_err(|e| format!("{d}/scenario.yaml: {e}"))?;
+    if sha256_hex(scenario.as_bytes()) != manifest.scenario_sha256 {
+        return Err(format!(
+            "{d}/scenario.yaml does not match its manifest (altered after it was written)"
+        ));
+    }
+    Ok(ShardOutput {
+        dir: dir.to_path_buf(),
+        manifest,
+        csv,
+        scenario,
+    })
+}
+
+/// Checks that `dirs` hold every shard of one campaign exactly once, unaltered and finished,
+/// and returns the campaign and its rows in run order.
+pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
+    if dirs.is_empty() {
+        return Err("expected the shard directories to merge".into());
+    }
+    let shards: Vec<ShardOutput> = dirs
+        .iter()
+        .map(|d| read_shard(d))
+        .collect::<Result<_, _>>()?;
+    let first = &shards[0];
+    let m0 = &first.manifest;
+    let Some([_, n]) = m0.shard else {
+        return Err(format!(
+            "{} holds a whole campaign, not a shard; there is nothing to merge",
+            first.dir.display()
+        ));
+    };
+    for s in &shards {
+        let m = &s.manifest;
+        let d = s.dir.display();
+        let mismatch = |what: &str, a: &dyn std::fmt::Display, b: &dyn std::fmt::Display| {
+            format!(
+                "{d} does not belong with {}: {what} {a} differs from {b}",
+                first.dir.display()
+            )
+        };
+        if m.polhode_version != m0.polhode_version {
+            return Err(mismatch(
+                "polhode version",
+                &m.polhode_version,
+                &m0.polhode_version,
+            ));
+        }
+        if m.scenario_sha256 != m0.scenario_sha256 {
+            return Err(mismatch(
+                "scenario (SHA-256)",
+                &m.scenario_sha256,
+                &m0.scenario_sha256,
+            ));
+        }
+        if m.seed != m0.seed {
+            return Err(mismatch("seed", &m.seed, &m0.seed));
+        }
+        if m.runs != m0.runs {
+            return Err(mismatch("run count", &m.runs, &m0.runs));
+        }
+        if m.columns != m0.columns {
+            return Err(mismatch(
+                "table columns",
+                &m.columns.len(),
+                &m0.columns.len(),
+            ));
+        }
+        match m.shard {
+            Some([_, n2]) if n2 == n => {}
+            Some([_, n2]) => return Err(mismatch("shard count", &n2, &n)),
+            None => return Err(format!("{d} holds a whole campaign, not a shard")),
+        }
+        if m.partial {
+            return Err(format!(
+                "{d} is partial (interrupted: {} of {} runs finished); re-run that shard",
+                m.runs_in_table,
+                m.run_range[1] - m.run_range[0]
+            ));
+        }
+    }
+    let mut by_index: BTreeMap<u64, &ShardOutput> = BTreeMap::new();
+    for s in &shards {
+        let k = s.manifest.shard.map_or(0, |[k, _]| k);
+        if let Some(other) = by_index.insert(k, s) {
+            return Err(format!(
+                "shard {k} of {n} is given twice: {} and {}",
+                other.dir.display(),
+                s.dir.display()
+            ));
+        }
+    }
+    let missing: Vec<String> = (1..=n)
+        .filter(|k| !by_index.contains_key(k))
+        .map(|k| k.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return Err(format!(
+            "shard(s) {} of {n} are missing; merge needs all {n}",
+            missing.join(", ")
+        ));
+    }
+    let sc = scenario::parse(
+        Path::new(&m0.scenario_file),
+        first.scenario.clone(),
+        &Overrides::default(),
+    )
+    .map_err(|e| format!("the shards' scenario no longer loads: {e}"))?;
+    let prep = Prepared::new(sc, &m0.scenario_file, Some(m0.runs), Some(m0.seed))
+        .map_err(|e| format!("the shards' campaign no longer loads: {e}"))?;
+    if prep.columns != m0.columns {
+        return Err("the shards were written with other table columns".into());
+    }
+    let mut rows = Vec::with_capacity(m0.runs as usize);
+    for (k, s) in &by_index {
+        let part = table::from_csv(&s.csv, &prep.columns)
+            .map_err(|e| format!("{}/runs.csv: {e}", s.dir.display()))?;
+        let range = shard_range(m0.runs, *k, n);
+        let expected: Vec<u64> = range.clone().collect();
+        let got: Vec<u64> = part.iter().map(|r| r.run).collect();
+        if got != expected || s.manifest.run_range != [range.start, range.end] {
+            return Err(format!(
+                "{}/runs.csv does not hold exactly runs {} to {} of shard {k}",
+                s.dir.display(),
+                range.start,
+                range.end.saturating_sub(1)
+            ));
+        }
+        rows.extend(part);
+    }
+    Ok((prep, rows))
+}

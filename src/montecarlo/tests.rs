@@ -1,0 +1,268 @@
+//! Dispersion statistics against their specification, and the independence of each run's
+//! random stream. Sample statistics are compared with the specified ones within five
+//! standard errors (the draws are seeded, so these tests are deterministic).
+
+use super::*;
+use nalgebra::UnitQuaternion;
+
+/// Draws per statistic.
+const N: u64 = 20_000;
+
+fn prepared(extra_body: &str, effectors: &str, dispersions: &str) -> Prepared {
+    let yaml = format!(
+        "name: stats\n\
+         body:\n  principal: [2.0, 2.1, 1.0]\n{extra_body}\
+         {effectors}\
+         initial:\n  omega: [0.05, 0.05, 2.0]\n  attitude: {{w: 0.8, x: 0.6, y: 0.0, z: 0.0}}\n\
+         duration: 1.0\n\
+         montecarlo:\n  runs: {N}\n  seed: 11\n  dispersions:\n{dispersions}"
+    );
+    let sc = scenario::parse(Path::new("stats.yaml"), yaml, &Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    Prepared::new(sc, "stats.yaml", None, None).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Recorded inputs of `n` runs.
+fn inputs(p: &Prepared, n: u64) -> Vec<Vec<f64>> {
+    (0..n)
+        .map(|i| p.build_run(i).unwrap_or_else(|e| panic!("run {i}: {e}")).1)
+        .collect()
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let s = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    (m, s)
+}
+
+/// Asserts that sample mean and sd of `v` match (`mean`, `sd`) within 5 standard errors
+/// (the sd's standard error is taken as sd/√(2n), exact for a Gaussian and close for the
+/// others used here).
+fn assert_matches(what: &str, v: &[f64], mean: f64, sd: f64) {
+    let n = v.len() as f64;
+    let (m, s) = mean_sd(v);
+    assert!(
+        (m - mean).abs() < 5.0 * sd / n.sqrt(),
+        "{what}: sample mean {m} vs {mean} (sd {sd}, n {n})"
+    );
+    assert!(
+        (s - sd).abs() < 5.0 * sd / (2.0 * n).sqrt() + 1e-15,
+        "{what}: sample sd {s} vs {sd}"
+    );
+}
+
+fn column(p: &Prepared, rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+    let j = p.columns.iter().position(|c| c == name).unwrap();
+    rows.iter().map(|r| r[j]).collect()
+}
+
+#[test]
+fn scalar_distributions_match_their_specification() {
+    let p = prepared(
+        "",
+        "effectors:\n  - energy_sink: {name: sink, time_constant: 10.0}\n",
+        "    - {path: \"initial.omega[0]\", normal: {sd: 0.01, mean: 0.002}}\n\
+         \x20   - {path: \"initial.omega[2]\", normal: {sd: 0.01, relative: true}}\n\
+         \x20   - {path: \"body.principal[0]\", uniform: {half_width: 0.02, relative: true}}\n\
+         \x20   - {path: duration, uniform: {min: 1.0, max: 3.0}}\n\
+         \x20   - {path: \"initial.omega[1]\", truncated_normal: {sd: 0.02, min: 0.03, max: 0.1}}\n\
+         \x20   - {path: \"effectors[sink].time_constant\", log_normal: {sigma: 0.3}}\n",
+    );
+    let rows = inputs(&p, N);
+    assert_matches(
+        "normal",
+        &column(&p, &rows, "initial.omega[0]"),
+        0.052,
+        0.01,
+    );
+    assert_matches(
+        "relative normal",
+        &column(&p, &rows, "initial.omega[2]"),
+        2.0,
+        0.02,
+    );
+    let u = column(&p, &rows, "body.principal[0]");
+    assert!(u.iter().all(|x| (1.96..=2.04).contains(x)));
+    assert_matches("uniform about", &u, 2.0, 0.04 / 3f64.sqrt());
+    let u = column(&p, &rows, "duration");
+    assert!(u.iter().all(|x| (1.0..=3.0).contains(x)));
+    assert_matches("uniform between", &u, 2.0, 2.0 / 12f64.sqrt());
+
+    // Truncated normal: moments of the density on [a, b] by Simpson's rule, independent of
+    // the sampler.
+    let (mu, s, a, b) = (0.05, 0.02, 0.03, 0.1);
+    let density = |x: f64| (-0.5 * ((x - mu) / s).powi(2)).exp();
+    let k = 20_000;
+    let h = (b - a) / k as f64;
+    let mut m = [0.0; 3];
+    for i in 0..=k {
+        let x = a + h * i as f64;
+        let w = if i == 0 || i == k {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        for (p, mp) in m.iter_mut().enumerate() {
+            *mp += w * x.powi(p as i32) * density(x);
+        }
+    }
+    let mean = m[1] / m[0];
+    let sd = (m[2] / m[0] - mean * mean).sqrt();
+    let t = column(&p, &rows, "initial.omega[1]");
+    assert!(t.iter().all(|x| (a..=b).contains(x)));
+    assert_matches("truncated normal", &t, mean, sd);
+
+    let logs: Vec<f64> = column(&p, &rows, "effectors[sink].time_constant")
+        .iter()
+        .map(|x| (x / 10.0).ln())
+        .collect();
+    assert_matches("log-normal (log of the factor)", &logs, 0.0, 0.3);
+}
+
+#[test]
+fn rotations_have_the_specified_spread() {
+    let sd = 2f64.to_radians();
+    let p = prepared(
+        "",
+        "",
+        "    - {path: initial.omega, tilt: {sd_deg: 2.0}}\n\
+         \x20   - {attitude: {sd_deg: 2.0}}\n",
+    );
+    let w0 = nalgebra::Vector3::<f64>::new(0.05, 0.05, 2.0);
+    let q0 = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(0.8, 0.6, 0.0, 0.0));
+    let mut tilt2 = Vec::new();
+    let mut att2 = Vec::new();
+    for i in 0..N {
+        let (sc, rec) = p.build_run(i).unwrap();
+        // The tilt keeps |ω| and moves its direction; the angle is Rayleigh: E θ² = 2 sd².
+        assert!((sc.omega0.norm() - w0.norm()).abs() < 1e-12 * w0.norm());
+        tilt2.push(sc.omega0.angle(&w0).powi(2));
+        // The attitude is q0 ⊗ Exp(θ) with θ ~ N(0, sd² I₃): E θ² = 3 sd².
+        let angle = q0.rotation_to(&sc.attitude0).angle();
+        let recorded = rec[3].to_radians();
+        assert!((angle - recorded).abs() < 1e-9, "{angle} vs {recorded}");
+        att2.push(angle * angle);
+    }
+    let (m, _) = mean_sd(&tilt2);
+    // θ² of a Rayleigh angle is exponential with mean 2 sd² and the same sd.
+    assert!(
+        (m - 2.0 * sd * sd).abs() < 5.0 * 2.0 * sd * sd / (N as f64).sqrt(),
+        "{m}"
+    );
+    let (m, _) = mean_sd(&att2);
+    // θ² / sd² is chi-square with 3 degrees of freedom: mean 3, variance 6.
+    assert!(
+        (m - 3.0 * sd * sd).abs() < 5.0 * 6f64.sqrt() * sd * sd / (N as f64).sqrt(),
+        "{m}"
+    );
+}
+
+#[test]
+fn inertia_draws_stay_physical_and_redraws_are_counted() {
+    // Moments and axes: far from the triangle boundary, almost nothing is redrawn.
+    let p = prepared("", "", "    - {inertia: {sd: 0.01, axes_sd_deg: 1.0}}\n");
+    let rows = inputs(&p, 5000);
+    for (k, nominal) in [2.0, 2.1, 1.0].iter().enumerate() {
+        let v: Vec<f64> = column(&p, &rows, &format!("inertia_moment_{}", k + 1))
+            .iter()
+            .map(|x| x / nominal)
+            .collect();
+        assert_matches("moment", &v, 1.0, 0.01);
+    }
+    let axes: Vec<f64> = column(&p, &rows, "inertia_axes_rotation_deg")
+        .iter()
+        .map(|d| d.to_radians().powi(2))
+        .collect();
+    let s2 = 1f64.to_radians().powi(2);
+    let (m, _) = mean_sd(&axes);
+    assert!((m - 3.0 * s2).abs() < 5.0 * 6f64.sqrt() * s2 / (5000f64).sqrt());
+    // The built hub has the drawn moments.
+    let (sc, rec) = p.build_run(3).unwrap();
+    let mut drawn = [rec[0], rec[1], rec[2]];
+    drawn.sort_by(f64::total_cmp);
+    for (k, want) in drawn.iter().enumerate() {
+        let got = sc.spacecraft.hub.principal_moments[k];
+        assert!((got - want).abs() < 1e-12 * want, "{got} vs {want}");
+    }
+
+    // A flat plate (1, 1, 2) sits on the boundary I1 + I2 = I3: a draw breaks it exactly when
+    // z1 + z2 − 2 z3 < 0, with probability 1/2. Redraws are then geometric with mean 1 and
+    // standard deviation √2.
+    let p = prepared("", "", "    - {inertia: {sd: 0.01}}\n");
+    let mut plate = p.tree.clone();
+    plate["body"]["principal"] = serde_json::json!([1.0, 1.0, 2.0]);
+    let p = Prepared { tree: plate, ..p };
+    let rows = inputs(&p, N);
+    let redraws = column(&p, &rows, "inertia_redraws");
+    let (m, _) = mean_sd(&redraws);
+    assert!(
+        (m - 1.0).abs() < 5.0 * 2f64.sqrt() / (N as f64).sqrt(),
+        "mean redraws {m}"
+    );
+    for r in &rows {
+        let (a, b, c) = (r[0], r[1], r[2]);
+        assert!(a + b >= c && b + c >= a && c + a >= b, "{a} {b} {c}");
+    }
+}
+
+fn reparse(p: &Prepared) -> Scenario {
+    scenario::parse(
+        Path::new("stats.yaml"),
+        p.scenario.source.clone(),
+        &Overrides::default(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn each_run_draws_from_its_own_stream() {
+    let p = prepared("", "", "    - {path: initial.omega, normal: {sd: 0.01}}\n");
+    let forward: Vec<Vec<f64>> = inputs(&p, 50);
+    // Any order, any campaign size: run i draws the same numbers.
+    let q = Prepared::new(reparse(&p), "stats.yaml", Some(7), None).unwrap();
+    for i in (0..50).rev() {
+        assert_eq!(p.build_run(i).unwrap().1, forward[i as usize]);
+        if i < 7 {
+            assert_eq!(q.build_run(i).unwrap().1, forward[i as usize]);
+        }
+    }
+    // Different runs and different seeds draw differently.
+    assert_ne!(forward[0], forward[1]);
+    let r = Prepared::new(reparse(&p), "stats.yaml", None, Some(12)).unwrap();
+    assert_ne!(r.build_run(0).unwrap().1, forward[0]);
+}
+
+#[test]
+fn shards_partition_the_runs() {
+    for runs in [1u64, 2, 7, 100, 10_001] {
+        for n in 1..=runs.min(13) {
+            let mut next = 0;
+            for k in 1..=n {
+                let r = shard_range(runs, k, n);
+                assert_eq!(r.start, next);
+                let len = r.end - r.start;
+                assert!(len == runs / n || len == runs / n + 1);
+                next = r.end;
+            }
+            assert_eq!(next, runs);
+        }
+    }
+}
+
+#[test]
+fn erfc_matches_tabulated_values() {
+    // Abramowitz and Stegun, Table 7.1: erf(0.5) = 0.5204998778, erf(1) = 0.8427007929,
+    // erf(2) = 0.9953222650.
+    for (x, erf) in [
+        (0.5, 0.520_499_877_8),
+        (1.0, 0.842_700_792_9),
+        (2.0, 0.995_322_265_0),
+    ] {
+        assert!((1.0 - erfc(x) - erf).abs() < 2e-7, "{x}");
+        assert!((erfc(-x) - (1.0 + erf)).abs() < 2e-7, "{x}");
+    }
+    assert!((normal_mass(-1.959_963_985, 1.959_963_985) - 0.95).abs() < 1e-6);
+}

@@ -1,0 +1,498 @@
+//! Monte Carlo campaigns from the command line: the same result whatever the threads and the
+//! sharding, merge refusing bad shard sets, Ctrl-C keeping a valid partial result, bad
+//! campaign definitions, and the Parquet table read by an independent reader.
+
+use std::collections::BTreeMap;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+const SCENARIO: &str = "tests/data/montecarlo-sink.yaml";
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn polhode() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_polhode"));
+    c.current_dir(root());
+    c
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("polhode-mc-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn campaign(args: &[&str], out: &Path) -> Output {
+    let o = polhode()
+        .arg("montecarlo")
+        .args(args)
+        .args(["--quiet", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
+fn merge(dirs: &[&Path], out: &Path) -> Output {
+    polhode()
+        .arg("merge")
+        .args(dirs)
+        .args(["--quiet", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap()
+}
+
+/// Every file of a result directory by name (temporary files would show up here too).
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect()
+}
+
+fn assert_same(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    assert_eq!(
+        fa.keys().collect::<Vec<_>>(),
+        fb.keys().collect::<Vec<_>>(),
+        "{} vs {}",
+        a.display(),
+        b.display()
+    );
+    for (name, bytes) in &fa {
+        assert!(
+            bytes == &fb[name],
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn threads_order_and_shards_give_the_same_result_bit_for_bit() {
+    let dir = scratch("repro");
+    let one = dir.join("one");
+    let two = dir.join("two");
+    campaign(&[SCENARIO, "--runs", "60", "--threads", "1"], &one);
+    campaign(&[SCENARIO, "--runs", "60", "--threads", "2"], &two);
+    assert_same(&one, &two);
+    let expected = [
+        "campaign.json",
+        "campaign.mcap",
+        "flat_spin_time_cdf.png",
+        "flat_spin_time_cdf.svg",
+        "flat_spin_time_histogram.png",
+        "flat_spin_time_histogram.svg",
+        "runs.csv",
+        "runs.parquet",
+        "scenario.yaml",
+        "summary.json",
+        "summary.txt",
+        "transverse_rate_vs_flat_spin_time.png",
+        "transverse_rate_vs_flat_spin_time.svg",
+    ];
+    assert_eq!(files(&one).keys().cloned().collect::<Vec<_>>(), expected);
+
+    // Four shards with uneven sizes, run in reverse order on two threads, merged in a
+    // shuffled order.
+    let shards: Vec<PathBuf> = (1..=4).map(|k| dir.join(format!("shard-{k}"))).collect();
+    for k in (1..=4).rev() {
+        let spec = format!("{k}/4");
+        campaign(
+            &[SCENARIO, "--runs", "60", "--shard", &spec, "--threads", "2"],
+            &shards[k - 1],
+        );
+    }
+    let shard_files = files(&shards[0]);
+    assert!(
+        !shard_files.contains_key("campaign.mcap"),
+        "shards skip the MCAP"
+    );
+    let m = json(&shards[1].join("campaign.json"));
+    assert_eq!(m["shard"], serde_json::json!([2, 4]));
+    assert_eq!(m["run_range"], serde_json::json!([15, 30]));
+    let merged = dir.join("merged");
+    let o = merge(&[&shards[2], &shards[0], &shards[3], &shards[1]], &merged);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_same(&one, &merged);
+
+    let summary = json(&one.join("summary.json"));
+    assert_eq!(summary["partial"], false);
+    assert_eq!(summary["runs_in_table"], 60);
+    assert_eq!(summary["status"]["complete"], 60);
+    // Every run of this scene goes flat within 200 s.
+    let by = &summary["events"][1]["by"];
+    assert_eq!(by[2]["t"], 200.0);
+    assert_eq!(by[2]["probability"], 1.0);
+}
+
+#[test]
+fn merge_refuses_bad_shard_sets() {
+    let dir = scratch("refuse");
+    let shard = |k: u32, n: u32, seed: &str, name: &str| {
+        let out = dir.join(name);
+        let spec = format!("{k}/{n}");
+        campaign(
+            &[SCENARIO, "--runs", "12", "--seed", seed, "--shard", &spec],
+            &out,
+        );
+        out
+    };
+    let s1 = shard(1, 3, "5", "s1");
+    let s2 = shard(2, 3, "5", "s2");
+    let s3 = shard(3, 3, "5", "s3");
+    let other_seed = shard(3, 3, "6", "s3-seed6");
+    let other_count = shard(2, 2, "5", "s2of2");
+    let out = dir.join("out");
+    let refused = |dirs: &[&Path], expect: &str| {
+        let o = merge(dirs, &out);
+        assert_eq!(o.status.code(), Some(2), "{dirs:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(expect), "{dirs:?}: {}", stderr(&o));
+        assert!(
+            !out.join("campaign.json").exists(),
+            "nothing may be written"
+        );
+    };
+    refused(&[&s1, &s2], "shard(s) 3 of 3 are missing");
+    refused(&[&s1, &s2, &s2, &s3], "shard 2 of 3 is given twice");
+    refused(&[&s1, &s2, &other_seed], "seed 6 differs from 5");
+    refused(&[&s1, &s2, &other_count], "shard count 2 differs from 3");
+
+    // A different scenario.
+    let edited = dir.join("edited.yaml");
+    let text = std::fs::read_to_string(root().join(SCENARIO)).unwrap();
+    std::fs::write(
+        &edited,
+        text.replace("time_constant: 10.0", "time_constant: 11.0"),
+    )
+    .unwrap();
+    let s3_other = dir.join("s3-other");
+    campaign(
+        &[
+            edited.to_str().unwrap(),
+            "--runs",
+            "12",
+            "--seed",
+            "5",
+            "--shard",
+            "3/3",
+        ],
+        &s3_other,
+    );
+    refused(&[&s1, &s2, &s3_other], "scenario (SHA-256)");
+
+    // A table truncated or altered after it was written.
+    let cut = dir.join("s3-cut");
+    std::fs::create_dir_all(&cut).unwrap();
+    for (name, bytes) in files(&s3) {
+        std::fs::write(cut.join(&name), bytes).unwrap();
+    }
+    let csv = std::fs::read(cut.join("runs.csv")).unwrap();
+    std::fs::write(cut.join("runs.csv"), &csv[..csv.len() - 10]).unwrap();
+    refused(&[&s1, &s2, &cut], "truncated or altered");
+    let mut altered = csv.clone();
+    let i = altered.iter().rposition(|b| b.is_ascii_digit()).unwrap();
+    altered[i] = if altered[i] == b'1' { b'2' } else { b'1' };
+    std::fs::write(cut.join("runs.csv"), &altered).unwrap();
+    refused(&[&s1, &s2, &cut], "truncated or altered");
+
+    // Not a campaign output at all.
+    refused(
+        &[&s1, &s2, &dir.join("nothing-here")],
+        "no finished campaign output",
+    );
+
+    // The right set merges.
+    let o = merge(&[&s1, &s2, &s3], &out);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn ctrl_c_keeps_every_finished_run_in_a_valid_partial_result() {
+    let dir = scratch("sigint");
+    let out = dir.join("partial");
+    let mut child = polhode()
+        .args([
+            "montecarlo",
+            SCENARIO,
+            "--runs",
+            "1000000",
+            "--threads",
+            "2",
+            "--shard",
+            "1/2",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The first line on stderr announces the start; let some runs finish, then interrupt.
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    err.read_line(&mut line).unwrap();
+    assert!(line.contains("runs"), "{line}");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{rest}");
+    assert!(rest.contains("marked partial"), "{rest}");
+
+    let manifest = json(&out.join("campaign.json"));
+    assert_eq!(manifest["partial"], true);
+    let n = manifest["runs_in_table"].as_u64().unwrap();
+    assert!(n > 0 && n < 500_000, "{n} runs finished");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["partial"], true);
+    assert_eq!(summary["runs_in_table"], n);
+    assert!(
+        std::fs::read_to_string(out.join("summary.txt"))
+            .unwrap()
+            .contains("PARTIAL")
+    );
+    // The table is whole: every row it lists is the row a full campaign computes for that run.
+    let csv = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len() as u64, n + 1);
+    let full = dir.join("full");
+    campaign(
+        &[SCENARIO, "--runs", "1000000", "--shard", "1/50000"],
+        &full,
+    );
+    let full_csv = std::fs::read_to_string(full.join("runs.csv")).unwrap();
+    let reference: BTreeMap<&str, &str> = full_csv
+        .lines()
+        .skip(1)
+        .map(|l| (l.split(',').next().unwrap(), l))
+        .collect();
+    let mut checked = 0;
+    for l in &lines[1..] {
+        if let Some(r) = reference.get(l.split(',').next().unwrap()) {
+            assert_eq!(l, r);
+            checked += 1;
+        }
+    }
+    assert!(
+        checked > 0,
+        "no run of the partial table was among the first 20"
+    );
+    // No temporary files are left, and a partial shard cannot be merged.
+    assert!(files(&out).keys().all(|f| !f.contains(".tmp")));
+    let o = merge(&[&out, &full], &dir.join("merged"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("partial"), "{}", stderr(&o));
+}
+
+#[test]
+fn bad_campaign_definitions_are_located_errors() {
+    let dir = scratch("bad");
+    let base = std::fs::read_to_string(root().join(SCENARIO)).unwrap();
+    let case = |name: &str, from: &str, to: &str, expect: &[&str]| {
+        let file = dir.join(format!("{name}.yaml"));
+        assert!(base.contains(from), "{from}");
+        std::fs::write(&file, base.replace(from, to)).unwrap();
+        let out = dir.join(name);
+        let o = polhode()
+            .args([
+                "montecarlo",
+                file.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        for e in expect {
+            assert!(
+                stderr(&o).contains(e),
+                "{name}: expected `{e}` in {}",
+                stderr(&o)
+            );
+        }
+        assert!(
+            !out.join("campaign.json").exists(),
+            "{name}: nothing may be written"
+        );
+        assert!(!stderr(&o).contains("panicked"));
+    };
+    case(
+        "unknown-field",
+        "path: \"effectors[sink].time_constant\"",
+        "path: \"effectors[sink].time_konstant\"",
+        &[
+            "montecarlo.dispersions[2].path",
+            ":25:14:",
+            "did you mean `time_constant`",
+        ],
+    );
+    case(
+        "unknown-entry",
+        "effectors[sink]",
+        "effectors[damper]",
+        &["no entry named `damper`", "names: sink"],
+    );
+    case(
+        "two-distributions",
+        "log_normal: {sigma: 0.3}",
+        "log_normal: {sigma: 0.3}, normal: {sd: 1.0}",
+        &["exactly one of", "normal, log_normal"],
+    );
+    case(
+        "wrong-length",
+        "path: initial.omega, tilt: {sd_deg: 1.0}",
+        "path: initial.omega, normal: {sd: [1.0, 2.0]}",
+        &["one number or 3"],
+    );
+    case(
+        "zero-runs",
+        "runs: 40",
+        "runs: 0",
+        &["montecarlo.runs", "from 1 to"],
+    );
+    case(
+        "unknown-key",
+        "probability_by:",
+        "probability_bye:",
+        &["montecarlo", "did you mean `probability_by`"],
+    );
+    case(
+        "not-numeric",
+        "path: initial.omega, tilt",
+        "path: name, tilt",
+        &["not a number or a list of numbers"],
+    );
+    case(
+        "narrow-truncation",
+        "min: 1.8, max: 2.3",
+        "min: 3.0, max: 3.1",
+        &["keep too little of the distribution"],
+    );
+    case(
+        "telemetry",
+        "final_telemetry: [h_norm]",
+        "final_telemetry: [h_nrom]",
+        &["unknown telemetry field `h_nrom`", "did you mean `h_norm`"],
+    );
+    // A whole-number field cannot be dispersed.
+    let rods = root().join("scenarios/explorer1-pydy.yaml");
+    let text = std::fs::read_to_string(&rods).unwrap();
+    let text = text.split("\nmontecarlo:").next().unwrap().to_string() + "\n";
+    let file = dir.join("count.yaml");
+    std::fs::write(
+        &file,
+        format!(
+            "{text}montecarlo:\n  runs: 2\n  dispersions:\n    - {{path: \"effectors[0].copies.count\", normal: {{sd: 1.0}}}}\n"
+        ),
+    )
+    .unwrap();
+    let o = polhode()
+        .args([
+            "montecarlo",
+            file.to_str().unwrap(),
+            "--out",
+            dir.join("c").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot be dispersed"), "{}", stderr(&o));
+    // Options.
+    for (args, expect) in [
+        (vec!["--shard", "0/3"], "expected K/N"),
+        (vec!["--shard", "4/3"], "expected K/N"),
+        (vec!["--shard", "1/41"], "at most 40 shards"),
+        (vec!["--threads", "0"], "at least 1"),
+        (vec!["--runs", "0"], "--runs"),
+    ] {
+        let o = polhode()
+            .args(["montecarlo", SCENARIO])
+            .args(&args)
+            .args(["--out", dir.join("opt").to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(expect), "{args:?}: {}", stderr(&o));
+    }
+    // A scenario without a campaign.
+    let o = polhode()
+        .args([
+            "montecarlo",
+            "scenarios/tennis-racket.yaml",
+            "--out",
+            dir.join("none").to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("expected a `montecarlo:` block"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn parquet_table_matches_the_csv_in_an_independent_reader() {
+    let dir = scratch("parquet");
+    let out = dir.join("out");
+    campaign(&[SCENARIO, "--runs", "25"], &out);
+    let python = root().join(".venv/bin/python");
+    assert!(
+        python.exists(),
+        "{} is missing: run scripts/python-venv.sh (scripts/test.sh does it for you)",
+        python.display()
+    );
+    let o = Command::new(python)
+        .arg(root().join("tests/python/read_parquet.py"))
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}{}", stderr(&o));
+    assert!(text.contains("rows 25 columns 32 identical"), "{text}");
+}
+
+#[test]
+fn every_shipped_campaign_is_valid() {
+    for entry in std::fs::read_dir(root().join("scenarios")).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        if !text.contains("\nmontecarlo:") {
+            continue;
+        }
+        let sc = polhode::scenario::load(&path, &Default::default()).unwrap();
+        let p = polhode::montecarlo::Prepared::new(sc, "x", None, None)
+            .unwrap_or_else(|e| panic!("{e}"));
+        // The first draws build valid scenarios.
+        for i in 0..20 {
+            p.build_run(i)
+                .unwrap_or_else(|e| panic!("{}: run {i}: {e}", path.display()));
+        }
+    }
+}
