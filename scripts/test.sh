@@ -4,8 +4,9 @@
 #
 #   scripts/test.sh
 #
-# Needs cargo (with rustfmt and clippy) and python3 with the venv module; installs the Python
-# packages of the independent MCAP reader into .venv (tests/python/requirements.txt).
+# Needs cargo (with rustfmt and clippy), python3 with the venv module, and root on Debian for
+# the SLURM test; installs the Python packages of the independent MCAP and Parquet readers
+# into .venv (tests/python/requirements.txt).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -13,3 +14,7 @@ scripts/python-venv.sh
 cargo fmt --all -- --check
 cargo clippy --release --all-targets --locked -- -D warnings
 cargo test --release --locked --lib --bins --tests
+# A Monte Carlo campaign as a SLURM job array on a real one-node cluster (installs Debian's
+# slurm-wlm and munge if missing; needs root): the merged shards must equal a single-process
+# run byte for byte (docs/cluster.md).
+RUNS=200 SHARDS=4 SEED=3 scripts/slurm/test-local.sh tests/data/montecarlo-sink.yaml
