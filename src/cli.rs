@@ -1205,15 +1205,12 @@ fn montecarlo_cmd(
         eprintln!("error: cannot write to {}: {e}", dir.display());
         return EXIT_BAD_INPUT;
     }
-    let interrupt = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupt.clone();
-        let _ = ctrlc::set_handler(move || {
-            if flag.swap(true, Ordering::SeqCst) {
-                std::process::exit(EXIT_INTERRUPTED);
-            }
-        });
+    // A previous campaign's files go first, so a run that dies leaves no stale manifest.
+    if let Err(e) = crate::montecarlo::output::clear_outputs(&dir) {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
     }
+    let interrupt = campaign_interrupt();
     let total = range.end - range.start;
     if !quiet {
         eprintln!(
@@ -1229,7 +1226,7 @@ fn montecarlo_cmd(
         let bar = indicatif::ProgressBar::new(total);
         bar.set_style(
             indicatif::ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} runs, ETA {eta} | {msg}",
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} runs, ETA {eta} | {msg}",
             )
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
@@ -1249,10 +1246,10 @@ fn montecarlo_cmd(
         }
         if let Some(b) = &bar {
             b.inc(1);
-            let mean = if s.reached > 0 {
-                format!(", mean {:.1} min", s.time_sum / s.reached as f64 / 60.0)
-            } else {
-                String::new()
+            let mean = match s.time_sum / s.reached.max(1) as f64 {
+                _ if s.reached == 0 => String::new(),
+                t if t < 120.0 => format!(", mean {t:.1} s"),
+                t => format!(", mean {:.1} min", t / 60.0),
             };
             let flat = if primary.is_some() {
                 format!("flat spin in {}/{}{mean}; ", s.reached, s.done)
@@ -1279,10 +1276,15 @@ fn montecarlo_cmd(
         eprintln!("interrupted before any run finished; nothing was written");
         return EXIT_INTERRUPTED;
     }
-    if let Err(e) = montecarlo::output::write_outputs(&dir, &prep, &rows, shard, partial) {
-        eprintln!("error: {e}");
-        return EXIT_IO;
-    }
+    WRITING_OUTPUTS.store(true, Ordering::SeqCst);
+    let written =
+        match montecarlo::output::write_outputs(&dir, &prep, &rows, shard, partial, &interrupt) {
+            Ok(w) => w,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_IO;
+            }
+        };
     if !quiet {
         if let Ok(text) = std::fs::read_to_string(dir.join("summary.txt")) {
             print!("{text}");
@@ -1298,13 +1300,40 @@ fn montecarlo_cmd(
     }
     if partial {
         eprintln!(
-            "interrupted: {} of {total} runs finished; the result in {} is marked partial",
+            "interrupted: {} of {total} runs finished; the result in {} is marked partial \
+             (no campaign.mcap)",
             rows.len(),
             dir.display()
         );
         return EXIT_INTERRUPTED;
     }
+    if written.mcap_interrupted {
+        eprintln!(
+            "interrupted while logging the worst, median and best runs: every run is in {}, \
+             but campaign.mcap was not written",
+            dir.display()
+        );
+        return EXIT_INTERRUPTED;
+    }
     0
+}
+
+/// Set while a campaign writes its outputs: a second Ctrl-C then no longer exits at once,
+/// so the outputs of the finished runs are not lost half-way.
+static WRITING_OUTPUTS: AtomicBool = AtomicBool::new(false);
+
+/// The Ctrl-C flag of `montecarlo` and `merge`: the first Ctrl-C sets it (runs under way are
+/// abandoned, the MCAP's re-runs stop); a second exits at once unless outputs are being
+/// written.
+fn campaign_interrupt() -> Arc<AtomicBool> {
+    let interrupt = Arc::new(AtomicBool::new(false));
+    let flag = interrupt.clone();
+    let _ = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) && !WRITING_OUTPUTS.load(Ordering::SeqCst) {
+            std::process::exit(EXIT_INTERRUPTED);
+        }
+    });
+    interrupt
 }
 
 fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
@@ -1316,9 +1345,22 @@ fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
             return EXIT_BAD_INPUT;
         }
     };
-    if let Err(e) = montecarlo::output::write_outputs(out, &prep, &rows, None, false) {
-        eprintln!("error: {e}");
-        return EXIT_IO;
+    let interrupt = campaign_interrupt();
+    WRITING_OUTPUTS.store(true, Ordering::SeqCst);
+    let written =
+        match montecarlo::output::write_outputs(out, &prep, &rows, None, false, &interrupt) {
+            Ok(w) => w,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_IO;
+            }
+        };
+    if written.mcap_interrupted {
+        eprintln!(
+            "interrupted: the merged result is in {}, but campaign.mcap was not written",
+            out.display()
+        );
+        return EXIT_INTERRUPTED;
     }
     if !quiet {
         if let Ok(text) = std::fs::read_to_string(out.join("summary.txt")) {

@@ -117,6 +117,47 @@ impl Prepared {
         if let Some(s) = seed {
             campaign.seed = s;
         }
+        // The dispersions applied in order to the nominal tree (with throwaway draws): each
+        // must still find its field when its turn comes (an `inertia` dispersion replaces
+        // `body.principal` by `body.inertia`), and none may touch the conditions that name
+        // the table's columns.
+        let mut trial = tree.clone();
+        let mut rng = ChaCha8Rng::seed_from_u64(0);
+        for (k, d) in campaign.dispersions.iter().enumerate() {
+            let field = format!("montecarlo.dispersions[{k}]");
+            if let Target::Path(p) = &d.target {
+                if p.pointer.starts_with("/events/") || p.pointer.starts_with("/stop/") {
+                    return Err(ScenarioError::at(
+                        &path,
+                        d.at,
+                        format!("{field}.path"),
+                        "event and stop conditions name the table's columns and cannot be \
+                         dispersed",
+                    ));
+                }
+                let shape = match trial.pointer(&p.pointer) {
+                    Some(Value::Array(a)) if a.iter().all(Value::is_number) => Some(a.len()),
+                    Some(Value::Number(_)) => Some(1),
+                    _ => None,
+                };
+                if shape != Some(p.len) {
+                    return Err(ScenarioError::at(
+                        &path,
+                        d.at,
+                        format!("{field}.path"),
+                        format!(
+                            "`{}` is no longer there when this dispersion applies: an \
+                             earlier one replaced it (`inertia` turns `body.principal` into \
+                             `body.inertia`); list this dispersion before that one",
+                            d.label
+                        ),
+                    ));
+                }
+            }
+            let mut scratch = Vec::new();
+            // A failed throwaway draw says nothing about the structure; real draws report it.
+            let _ = d.apply(&mut trial, &mut rng, &mut scratch);
+        }
         // Each perturbed field must take a continuous value: the nominal value written as a
         // floating-point number (4 → 4.0) must still load; a count or a stage number fails.
         for (k, d) in campaign.dispersions.iter().enumerate() {
@@ -224,20 +265,29 @@ impl Prepared {
         rng
     }
 
-    /// The perturbed scenario of run `i` and the recorded inputs (`Err`: why the draw is not
-    /// a valid scenario).
-    pub fn build_run(&self, i: u64) -> Result<(Scenario, Vec<f64>), String> {
+    /// The perturbed scenario of run `i` and the recorded inputs.
+    pub fn build_run(&self, i: u64) -> Result<(Scenario, Vec<f64>), InvalidDraw> {
         let mut rng = self.stream(i);
         let mut tree = self.tree.clone();
         let mut inputs = Vec::new();
         for d in &self.campaign.dispersions {
-            d.apply(&mut tree, &mut rng, &mut inputs)?;
+            if let Err(message) = d.apply(&mut tree, &mut rng, &mut inputs) {
+                return Err(InvalidDraw { message, inputs });
+            }
         }
-        let text = serde_json::to_string(&tree).map_err(|e| e.to_string())?;
-        let mut sc = scenario::parse(&self.scenario.path, text, &Overrides::default())
-            .map_err(|e| format!("the perturbed scenario is not valid: {}", e.message))?;
-        sc.path = self.scenario_file.clone().into();
-        Ok((sc, inputs))
+        let parsed = serde_json::to_string(&tree)
+            .map_err(|e| e.to_string())
+            .and_then(|text| {
+                scenario::parse(&self.scenario.path, text, &Overrides::default())
+                    .map_err(|e| format!("the perturbed scenario is not valid: {}", e.message))
+            });
+        match parsed {
+            Ok(mut sc) => {
+                sc.path = self.scenario_file.clone().into();
+                Ok((sc, inputs))
+            }
+            Err(message) => Err(InvalidDraw { message, inputs }),
+        }
     }
 
     /// Runs `i` to the end; `None` if it was interrupted (it is then not part of the result).
@@ -245,7 +295,11 @@ impl Prepared {
         let mut values = vec![None; self.columns.len()];
         let (sc, inputs) = match self.build_run(i) {
             Ok(x) => x,
-            Err(message) => {
+            Err(InvalidDraw { message, inputs }) => {
+                // Keep what was drawn, so the table shows which draw was invalid.
+                for (k, v) in inputs.iter().enumerate() {
+                    values[k] = Some(*v);
+                }
                 return Some(Row {
                     run: i,
                     status: RunStatus::Invalid,
@@ -369,6 +423,21 @@ impl Prepared {
                 missing: f64::NEG_INFINITY,
             },
         }
+    }
+}
+
+/// A draw that is not a valid scenario: why, and the inputs drawn up to that point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InvalidDraw {
+    /// Why.
+    pub message: String,
+    /// The recorded inputs drawn before the failure.
+    pub inputs: Vec<f64>,
+}
+
+impl std::fmt::Display for InvalidDraw {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
     }
 }
 

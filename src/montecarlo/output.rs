@@ -22,6 +22,50 @@ use std::sync::atomic::AtomicBool;
 /// Format tag of `campaign.json`.
 pub const MANIFEST_FORMAT: &str = "polhode-campaign/1";
 
+/// Hash of the sources and `Cargo.lock` this binary was built from (build.rs).
+pub const BUILD_ID: &str = env!("POLHODE_BUILD_ID");
+
+/// Every file name a campaign may write, the manifest first: removed before writing, so a
+/// directory never mixes the files of two campaigns and never shows a manifest while its
+/// files are being replaced.
+const OUTPUT_FILES: [&str; 13] = [
+    "campaign.json",
+    "runs.csv",
+    "runs.parquet",
+    "scenario.yaml",
+    "summary.json",
+    "summary.txt",
+    "campaign.mcap",
+    "flat_spin_time_histogram.svg",
+    "flat_spin_time_histogram.png",
+    "flat_spin_time_cdf.svg",
+    "flat_spin_time_cdf.png",
+    "transverse_rate_vs_flat_spin_time.svg",
+    "transverse_rate_vs_flat_spin_time.png",
+];
+
+/// Removes a previous campaign's outputs from `dir` (the manifest first).
+pub fn clear_outputs(dir: &Path) -> Result<(), String> {
+    for name in OUTPUT_FILES {
+        let p = dir.join(name);
+        match std::fs::remove_file(&p) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(format!("cannot remove the old {}: {e}", p.display())),
+        }
+    }
+    Ok(())
+}
+
+/// What [`write_outputs`] wrote.
+#[derive(Debug, Default)]
+pub struct Written {
+    /// Files written.
+    pub files: Vec<PathBuf>,
+    /// Whether `campaign.mcap` was left out because `interrupt` was set while it was made.
+    pub mcap_interrupted: bool,
+}
+
 /// `campaign.json`: what was run, so that shards can be checked against each other.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Manifest {
@@ -29,10 +73,11 @@ pub struct Manifest {
     pub format: String,
     /// polhode version that wrote it.
     pub polhode_version: String,
+    /// Hash of the sources and `Cargo.lock` of the build that wrote it (`merge` refuses
+    /// shards of another build: the version does not change between commits).
+    pub build_id: String,
     /// Scenario `name:`.
     pub scenario: String,
-    /// Scenario file as named on the command line.
-    pub scenario_file: String,
     /// Hex SHA-256 of the scenario text.
     pub scenario_sha256: String,
     /// Campaign seed.
@@ -74,16 +119,20 @@ struct SummaryDoc<'a> {
     failures: Vec<Failure>,
 }
 
-/// Writes every output of `rows` (the runs of `range` that finished) into `dir`.
-/// `whole` adds the charts and the MCAP of the worst, median and best runs.
+/// Writes every output of `rows` (the runs of the range that finished) into `dir`, after
+/// removing a previous campaign's. A whole campaign (`shard` None) also gets the charts and,
+/// unless it is partial, the MCAP of its worst, median and best runs, which are re-run: if
+/// `interrupt` is set meanwhile, the MCAP is left out and everything else is still written.
 pub fn write_outputs(
     dir: &Path,
     prep: &Prepared,
     rows: &[Row],
     shard: Option<[u64; 2]>,
     partial: bool,
-) -> Result<Vec<PathBuf>, String> {
+    interrupt: &AtomicBool,
+) -> Result<Written, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    clear_outputs(dir)?;
     let range = match shard {
         Some([k, n]) => shard_range(prep.campaign.runs, k, n),
         None => 0..prep.campaign.runs,
@@ -110,8 +159,8 @@ pub fn write_outputs(
     let manifest = Manifest {
         format: MANIFEST_FORMAT.into(),
         polhode_version: env!("CARGO_PKG_VERSION").into(),
+        build_id: BUILD_ID.into(),
         scenario: prep.scenario.name.clone(),
-        scenario_file: prep.scenario_file.clone(),
         scenario_sha256: prep.scenario_sha256.clone(),
         seed: prep.campaign.seed,
         runs: prep.campaign.runs,
@@ -130,17 +179,24 @@ pub fn write_outputs(
         "summary.txt",
         summary_text(prep, &doc).as_bytes(),
     )?;
+    let mut mcap_interrupted = false;
     if shard.is_none() {
         written.extend(charts(dir, prep, rows)?);
         if let Some(r) = &doc.ranking
-            && let Some(p) = trajectories(dir, prep, r, &json)?
+            && !partial
         {
-            written.push(p);
+            match trajectories(dir, prep, r, &json, interrupt)? {
+                Some(p) => written.push(p),
+                None => mcap_interrupted = true,
+            }
         }
     }
     let m = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
     put(&mut written, "campaign.json", m.as_bytes())?;
-    Ok(written)
+    Ok(Written {
+        files: written,
+        mcap_interrupted,
+    })
 }
 
 fn summary_doc<'a>(prep: &'a Prepared, rows: &[Row], m: &'a Manifest) -> SummaryDoc<'a> {
@@ -358,6 +414,7 @@ fn trajectories(
     prep: &Prepared,
     ranking: &Ranking,
     summary_json: &str,
+    interrupt: &AtomicBool,
 ) -> Result<Option<PathBuf>, String> {
     let picks = [
         ("worst", ranking.worst),
@@ -369,7 +426,6 @@ fn trajectories(
         scenarios.push(prep.build_run(i).map_err(|e| format!("run {i}: {e}"))?.0);
     }
     let path = dir.join("campaign.mcap");
-    let never = AtomicBool::new(false);
     let mut logger: Option<McapLogger> = None;
     let mut meta = BTreeMap::new();
     let mut attachments = Vec::new();
@@ -384,11 +440,15 @@ fn trajectories(
             sc,
             &mut l,
             Control {
-                interrupt: &never,
+                interrupt,
                 progress: None,
             },
         )
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        if outcome.status == crate::sim::Status::Interrupted {
+            // Dropping the logger removes its temporary file.
+            return Ok(None);
+        }
         l.end_run(&outcome)
             .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         meta.insert(format!("{label}_run"), i.to_string());
@@ -403,7 +463,9 @@ fn trajectories(
         });
         logger = Some(l);
     }
-    let Some(l) = logger else { return Ok(None) };
+    let Some(l) = logger else {
+        return Err("no run to log".into());
+    };
     meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
     meta.insert("scenario".into(), prep.scenario.name.clone());
     meta.insert("seed".into(), prep.campaign.seed.to_string());
@@ -442,6 +504,21 @@ fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
         return Err(format!(
             "{d}/campaign.json has format `{}`; expected `{MANIFEST_FORMAT}`",
             manifest.format
+        ));
+    }
+    if let Some([k, n]) = manifest.shard
+        && !(1 <= k && k <= n && n <= manifest.runs)
+    {
+        return Err(format!(
+            "{d}/campaign.json names shard {k} of {n} of {} runs, which does not exist",
+            manifest.runs
+        ));
+    }
+    let [start, end] = manifest.run_range;
+    if start > end || end > manifest.runs {
+        return Err(format!(
+            "{d}/campaign.json has the impossible run range [{start}, {end}) of {} runs",
+            manifest.runs
         ));
     }
     let csv =
@@ -501,6 +578,16 @@ pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
                 &m0.polhode_version,
             ));
         }
+        if m.build_id != m0.build_id {
+            return Err(mismatch("polhode build", &m.build_id, &m0.build_id));
+        }
+        if m.build_id != BUILD_ID {
+            return Err(format!(
+                "{d} was written by another polhode build ({}) than this one ({BUILD_ID}); \
+                 merge with the binary that ran the shards",
+                m.build_id
+            ));
+        }
         if m.scenario_sha256 != m0.scenario_sha256 {
             return Err(mismatch(
                 "scenario (SHA-256)",
@@ -555,14 +642,20 @@ pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
             missing.join(", ")
         ));
     }
+    let scenario_path = first.dir.join("scenario.yaml");
     let sc = scenario::parse(
-        Path::new(&m0.scenario_file),
+        &scenario_path,
         first.scenario.clone(),
         &Overrides::default(),
     )
     .map_err(|e| format!("the shards' scenario no longer loads: {e}"))?;
-    let prep = Prepared::new(sc, &m0.scenario_file, Some(m0.runs), Some(m0.seed))
-        .map_err(|e| format!("the shards' campaign no longer loads: {e}"))?;
+    let prep = Prepared::new(
+        sc,
+        &scenario_path.display().to_string(),
+        Some(m0.runs),
+        Some(m0.seed),
+    )
+    .map_err(|e| format!("the shards' campaign no longer loads: {e}"))?;
     if prep.columns != m0.columns {
         return Err("the shards were written with other table columns".into());
     }

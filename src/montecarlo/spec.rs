@@ -9,7 +9,8 @@ use serde_json::Value;
 use serde_saphyr::Spanned;
 use std::path::Path;
 
-/// Most runs one campaign may ask for (the per-run table is held in memory: about 0.5 kB a run).
+/// Most runs one campaign may ask for: the per-run table is held in memory, about 2 kB a run at
+/// its peak (20 GB for this many).
 pub const MAX_RUNS: u64 = 10_000_000;
 
 /// `montecarlo:` as written.
@@ -433,7 +434,7 @@ fn dispersion(
             sd: angle(a, "tilt")?,
         }
     } else {
-        unreachable!("one distribution was checked to be present")
+        return Err(err("expected a distribution".into()));
     };
     Ok(Dispersion {
         label: p.value.trim().to_string(),

@@ -135,11 +135,26 @@ fn rotations_have_the_specified_spread() {
     let q0 = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(0.8, 0.6, 0.0, 0.0));
     let mut tilt2 = Vec::new();
     let mut att2 = Vec::new();
+    // Per-axis components: the tilt must be isotropic about ω₀ and the attitude rotation
+    // about all three body axes.
+    let u = w0.normalize();
+    let ea = u.cross(&nalgebra::Vector3::x()).normalize();
+    let eb = u.cross(&ea);
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    let mut axes: [Vec<f64>; 3] = Default::default();
     for i in 0..N {
         let (sc, rec) = p.build_run(i).unwrap();
         // The tilt keeps |ω| and moves its direction; the angle is Rayleigh: E θ² = 2 sd².
         assert!((sc.omega0.norm() - w0.norm()).abs() < 1e-12 * w0.norm());
         tilt2.push(sc.omega0.angle(&w0).powi(2));
+        let d = sc.omega0.normalize() - u;
+        ta.push(d.dot(&ea));
+        tb.push(d.dot(&eb));
+        // The rotation vector of q0⁻¹ q, in body axes.
+        let v = (q0.inverse() * sc.attitude0).scaled_axis();
+        for (k, a) in axes.iter_mut().enumerate() {
+            a.push(v[k]);
+        }
         // The attitude is q0 ⊗ Exp(θ) with θ ~ N(0, sd² I₃): E θ² = 3 sd².
         let angle = q0.rotation_to(&sc.attitude0).angle();
         let recorded = rec[3].to_radians();
@@ -152,6 +167,12 @@ fn rotations_have_the_specified_spread() {
         (m - 2.0 * sd * sd).abs() < 5.0 * 2.0 * sd * sd / (N as f64).sqrt(),
         "{m}"
     );
+    // Small angles: each component is N(0, sd²) to O(sd²) relative.
+    assert_matches("tilt, first perpendicular", &ta, 0.0, sd);
+    assert_matches("tilt, second perpendicular", &tb, 0.0, sd);
+    for (k, a) in axes.iter().enumerate() {
+        assert_matches(&format!("attitude axis {k}"), a, 0.0, sd);
+    }
     let (m, _) = mean_sd(&att2);
     // θ² / sd² is chi-square with 3 degrees of freedom: mean 3, variance 6.
     assert!(
