@@ -143,6 +143,10 @@ fn threads_order_and_shards_give_the_same_result_bit_for_bit() {
     let by = &summary["events"][1]["by"];
     assert_eq!(by[2]["t"], 200.0);
     assert_eq!(by[2]["probability"], 1.0);
+
+    // A shard written into a directory that held a whole campaign leaves none of its files.
+    campaign(&[SCENARIO, "--runs", "60", "--shard", "1/4"], &one);
+    assert_same(&one, &shards[0]);
 }
 
 #[test]
@@ -215,6 +219,27 @@ fn merge_refuses_bad_shard_sets() {
     std::fs::write(cut.join("runs.csv"), &altered).unwrap();
     refused(&[&s1, &s2, &cut], "truncated or altered");
 
+    // Shards of another build, and manifests naming a shard or range that cannot exist.
+    let other_build = dir.join("s3-build");
+    std::fs::create_dir_all(&other_build).unwrap();
+    for (name, bytes) in files(&s3) {
+        std::fs::write(other_build.join(&name), bytes).unwrap();
+    }
+    let manifest = std::fs::read_to_string(other_build.join("campaign.json")).unwrap();
+    let mut m: serde_json::Value = serde_json::from_str(&manifest).unwrap();
+    m["build_id"] = "0000000000000000".into();
+    std::fs::write(other_build.join("campaign.json"), m.to_string()).unwrap();
+    refused(&[&s1, &s2, &other_build], "polhode build");
+    refused(&[&other_build, &s1, &s2], "polhode build");
+    m = serde_json::from_str(&manifest).unwrap();
+    m["shard"] = serde_json::json!([1, 0]);
+    std::fs::write(other_build.join("campaign.json"), m.to_string()).unwrap();
+    refused(&[&s1, &s2, &other_build], "which does not exist");
+    m = serde_json::from_str(&manifest).unwrap();
+    m["run_range"] = serde_json::json!([9, 3]);
+    std::fs::write(other_build.join("campaign.json"), m.to_string()).unwrap();
+    refused(&[&s1, &s2, &other_build], "impossible run range");
+
     // Not a campaign output at all.
     refused(
         &[&s1, &s2, &dir.join("nothing-here")],
@@ -252,7 +277,7 @@ fn ctrl_c_keeps_every_finished_run_in_a_valid_partial_result() {
     let mut line = String::new();
     err.read_line(&mut line).unwrap();
     assert!(line.contains("runs"), "{line}");
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    std::thread::sleep(std::time::Duration::from_millis(3000));
     let kill = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
@@ -281,10 +306,7 @@ fn ctrl_c_keeps_every_finished_run_in_a_valid_partial_result() {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len() as u64, n + 1);
     let full = dir.join("full");
-    campaign(
-        &[SCENARIO, "--runs", "1000000", "--shard", "1/50000"],
-        &full,
-    );
+    campaign(&[SCENARIO, "--runs", "1000000", "--shard", "1/5000"], &full);
     let full_csv = std::fs::read_to_string(full.join("runs.csv")).unwrap();
     let reference: BTreeMap<&str, &str> = full_csv
         .lines()
@@ -300,7 +322,7 @@ fn ctrl_c_keeps_every_finished_run_in_a_valid_partial_result() {
     }
     assert!(
         checked > 0,
-        "no run of the partial table was among the first 20"
+        "no run of the partial table was among the first 200"
     );
     // No temporary files are left, and a partial shard cannot be merged.
     assert!(files(&out).keys().all(|f| !f.contains(".tmp")));
@@ -394,6 +416,22 @@ fn bad_campaign_definitions_are_located_errors() {
         &["keep too little of the distribution"],
     );
     case(
+        "after-inertia",
+        "    - {attitude: {sd_deg: 2.0}}\n",
+        "    - {attitude: {sd_deg: 2.0}}\n    - {path: \"body.principal[0]\", normal: {sd: 0.01}}\n",
+        &[
+            "montecarlo.dispersions[6].path",
+            "no longer there",
+            "list this dispersion before",
+        ],
+    );
+    case(
+        "event-threshold",
+        "path: initial.omega, tilt: {sd_deg: 1.0}",
+        "path: \"events[1].nutation_angle_deg.above\", normal: {sd: 1.0}",
+        &["cannot be dispersed"],
+    );
+    case(
         "telemetry",
         "final_telemetry: [h_norm]",
         "final_telemetry: [h_nrom]",
@@ -455,6 +493,51 @@ fn bad_campaign_definitions_are_located_errors() {
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn invalid_draws_are_recorded_with_what_was_drawn() {
+    let dir = scratch("invalid");
+    let text = std::fs::read_to_string(root().join(SCENARIO))
+        .unwrap()
+        .replace("log_normal: {sigma: 0.3}", "normal: {sd: 10.0}");
+    let file = dir.join("invalid.yaml");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("out");
+    campaign(&[file.to_str().unwrap(), "--runs", "30"], &out);
+    let summary = json(&out.join("summary.json"));
+    let invalid = summary["status"]["invalid"].as_u64().unwrap();
+    // A time constant drawn from N(10, 10²) is not positive in about 16 % of the runs.
+    assert!((1..15).contains(&invalid), "{invalid} invalid runs");
+    let table = polhode::montecarlo::table::from_csv(
+        &std::fs::read_to_string(out.join("runs.csv")).unwrap(),
+        &json(&out.join("campaign.json"))["columns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap().to_string())
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let columns = json(&out.join("campaign.json"))["columns"].clone();
+    let j = columns
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|c| c == "effectors[sink].time_constant")
+        .unwrap();
+    let mut seen = 0;
+    for row in table.iter().filter(|r| r.status.label() == "invalid") {
+        assert!(
+            row.message.contains("expected a positive"),
+            "{}",
+            row.message
+        );
+        // The draw that made it invalid is in the table.
+        assert!(row.values[j].unwrap() <= 0.0, "{row:?}");
+        seen += 1;
+    }
+    assert_eq!(seen, invalid);
 }
 
 #[test]
