@@ -1359,6 +1359,31 @@ pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// Writes `chart` as `<stem>.svg` (900 × 600) and `<stem>.png` (1350 × 900 px), each under a temporary name
+/// renamed when complete, and returns both paths.
+pub fn svg_and_png(
+    chart: &Chart,
+    stem: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>, String> {
+    let svg = chart.to_svg(900, 600);
+    let svg_path = stem.with_extension("svg");
+    crate::log::write_atomically(&svg_path, svg.as_bytes())
+        .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+    let png_path = stem.with_extension("png");
+    let name = png_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = png_path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    let result = write_png(&svg, &tmp)
+        .and_then(|()| std::fs::rename(&tmp, &png_path).map_err(|e| e.to_string()));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("{}: {e}", png_path.display()));
+    }
+    Ok(vec![svg_path, png_path])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

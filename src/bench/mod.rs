@@ -10,10 +10,9 @@ pub mod failure;
 pub mod work_precision;
 
 use crate::integrate::Stats;
-use crate::plot::Chart;
 use crate::scenario::{self, Overrides, Scenario};
 use crate::sim::{self, Solve};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A method as the benchmarks run it: a scenario method name plus its variant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -129,15 +128,7 @@ pub fn load_with(
     scenario::load(path, &overrides).map_err(|e| e.to_string())
 }
 
-/// Writes `chart` as `<stem>.svg` (900×600) and `<stem>.png` (1350×900 px); returns both paths.
-pub fn svg_and_png(chart: &Chart, stem: &Path) -> Result<Vec<PathBuf>, String> {
-    let svg = chart.to_svg(900, 600);
-    let svg_path = stem.with_extension("svg");
-    let png_path = stem.with_extension("png");
-    std::fs::write(&svg_path, &svg).map_err(|e| format!("{}: {e}", svg_path.display()))?;
-    crate::plot::write_png(&svg, &png_path)?;
-    Ok(vec![svg_path, png_path])
-}
+pub use crate::plot::svg_and_png;
 
 /// One timed solve of a scenario with its method.
 #[derive(Debug, Clone, serde::Serialize)]

@@ -392,19 +392,7 @@ fn charts(dir: &Path, prep: &Prepared, rows: &[Row]) -> Result<Vec<PathBuf>, Str
 }
 
 fn chart_files(chart: &Chart, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, String> {
-    let svg = chart.to_svg(900, 600);
-    let svg_path = dir.join(format!("{stem}.svg"));
-    write_atomically(&svg_path, svg.as_bytes())
-        .map_err(|e| format!("cannot write {}: {e}", svg_path.display()))?;
-    let png_path = dir.join(format!("{stem}.png"));
-    let tmp = dir.join(format!(".{stem}.{}.png.tmp", std::process::id()));
-    let result = crate::plot::write_png(&svg, &tmp)
-        .and_then(|()| std::fs::rename(&tmp, &png_path).map_err(|e| e.to_string()));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("cannot write {}: {e}", png_path.display()));
-    }
-    Ok(vec![svg_path, png_path])
+    crate::plot::svg_and_png(chart, &dir.join(stem)).map_err(|e| format!("cannot write {e}"))
 }
 
 /// `campaign.mcap`: the worst, median and best runs re-run with full logging under
