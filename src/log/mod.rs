@@ -99,7 +99,10 @@ struct SceneStyle {
 
 impl SceneStyle {
     fn of(scenario: &Scenario, outcome_ref_omega: f64) -> Self {
-        let h0 = (scenario.spacecraft.hub.inertia * scenario.omega0).norm();
+        // |H| of the whole spacecraft (hub and effectors) at t = 0.
+        let sc = &scenario.spacecraft;
+        let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
+        let h0 = sc.observe(0.0, &y0).h_norm;
         let size = match &scenario.shape {
             Shape::Box { size, .. } => size.max(),
             Shape::Cylinder { radius, length, .. } => length.max(2.0 * radius),
@@ -474,7 +477,8 @@ impl<'a> McapLogger<'a> {
         });
         let arrow = |v: &Vector3<f64>, reference: f64, rgb: (f64, f64, f64)| {
             let n = v.norm();
-            let length = self.scene.arrow_length * (n / reference).min(2.0);
+            // √ scaling keeps a tenfold drop of |ω| (a flat spin) visible: 32 % of the length.
+            let length = self.scene.arrow_length * (n / reference).sqrt().min(2.0);
             let orientation =
                 UnitQuaternion::rotation_between(&Vector3::x(), v).unwrap_or_else(|| {
                     if v.x < 0.0 {
