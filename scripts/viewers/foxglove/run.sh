@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Opens a polhode log in Foxglove Studio (open-source studio-base 1.48, headless Chromium) with
+# the shipped layout docs/viewers/polhode.foxglove-layout.json, saves two screenshots and checks
+# them. Installs what is missing (Debian's chromium, the npm packages of this folder), makes
+# the explorer1-pydy log, and writes $OUT/foxglove-early.png and $OUT/foxglove-late.png.
+#
+#   scripts/viewers/foxglove/run.sh
+#
+# Environment: POLHODE (the polhode binary; default target/release/polhode, built with cargo
+# if missing), OUT (default docs/figures/viewing), SCENARIO (default
+# scenarios/explorer1-pydy.yaml), EARLY and LATE (seconds into the log; default 10 and 120),
+# CHROMIUM (default /usr/bin/chromium). The checks want every plotted series visible: true of
+# explorer1-pydy, not of a rigid body, whose dissipated and elastic energies are both 0 and
+# hide each other.
+set -euo pipefail
+
+here="$(cd "$(dirname "$0")" && pwd)"
+repo="$(cd "$here/../../.." && pwd)"
+out="${OUT:-$repo/docs/figures/viewing}"
+scenario="${SCENARIO:-$repo/scenarios/explorer1-pydy.yaml}"
+chromium="${CHROMIUM:-/usr/bin/chromium}"
+now() { date +%s.%N; }
+since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+
+# Root runs apt-get directly; others need sudo.
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+# 1. Install what is missing.
+t_install=$(now)
+if [ ! -x "$chromium" ]; then
+  echo "installing chromium (apt)"
+  as_root apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+fi
+# npm keeps node_modules/.package-lock.json; reinstall when the lock file is newer.
+if [ ! -f "$here/node_modules/.package-lock.json" ] ||
+  [ "$here/package-lock.json" -nt "$here/node_modules/.package-lock.json" ]; then
+  echo "installing npm packages (npm ci)"
+  (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
+fi
+echo "install: $(since "$t_install") s"
+
+# 2. The polhode binary: $POLHODE, or the repository's release build (built if missing).
+if [ -n "${POLHODE:-}" ]; then
+  polhode="$POLHODE"
+else
+  polhode="$repo/target/release/polhode"
+  if [ ! -x "$polhode" ]; then
+    command -v cargo >/dev/null ||
+      { echo "FAIL: no $polhode and no cargo to build it (set POLHODE)" >&2; exit 1; }
+    echo "building polhode (cargo build --release)"
+    (cd "$repo" && cargo build --release --locked --quiet)
+  fi
+fi
+[ -x "$polhode" ] || { echo "FAIL: no polhode binary at $polhode (set POLHODE)" >&2; exit 1; }
+
+# 3. The log, in a temporary folder removed on exit.
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+log="$work/$(basename "$scenario" .yaml).mcap"
+t_log=$(now)
+if ! "$polhode" run "$scenario" --out "$log" >"$work/polhode.txt" 2>&1; then
+  cat "$work/polhode.txt" >&2
+  echo "FAIL: polhode could not make the log" >&2
+  exit 1
+fi
+echo "log: $(basename "$log"), $(du -h "$log" | cut -f1), $(since "$t_log") s"
+
+# 4. Screenshots and checks.
+t_shots=$(now)
+status=0
+node "$here/screenshots.mjs" --log "$log" --out "$out" --chromium "$chromium" \
+  --early "${EARLY:-10}" --late "${LATE:-120}" || status=$?
+echo "screenshots: $(since "$t_shots") s"
+if [ "$status" -eq 0 ]; then
+  echo "PASS (foxglove): $out/foxglove-early.png, $out/foxglove-late.png"
+else
+  echo "FAIL (foxglove)"
+fi
+exit "$status"

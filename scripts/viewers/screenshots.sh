@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Opens an Explorer 1 log in the real viewers and checks what they show (docs/viewing.md):
+#   - Foxglove Studio (the last open-source release, in headless Chromium) with the shipped
+#     layout docs/viewers/polhode.foxglove-layout.json, at two times: the body is drawn and has
+#     turned, the plots are drawn;
+#   - Rerun: `rerun mcap check` on a log of every shipped scenario, the MCAP converted to a
+#     native recording (`rerun rrd verify`, transforms and telemetry compared with the MCAP),
+#     and a headless screenshot with the body and the plots.
+#
+#   scripts/viewers/screenshots.sh [OUT_DIR]     (default docs/figures/viewing)
+#
+# Installs what is missing (Debian packages, npm and PyPI packages; needs root for apt).
+# Exits non-zero if any check fails. POLHODE selects the binary (default target/release/polhode).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+out=$(realpath -m "${1:-docs/figures/viewing}")
+mkdir -p "$out"
+OUT="$out" scripts/viewers/foxglove/run.sh
+OUT="$out/rerun.png" scripts/viewers/rerun/run.sh
