@@ -18,3 +18,9 @@ cargo test --release --locked --lib --bins --tests
 # slurm-wlm and munge if missing; needs root): the merged shards must equal a single-process
 # run byte for byte (docs/cluster.md).
 RUNS=200 SHARDS=4 SEED=3 scripts/slurm/test-local.sh tests/data/montecarlo-sink.yaml
+# The logs in the real viewers (docs/viewing.md): Foxglove Studio in headless Chromium with the
+# shipped layout, and Rerun (mcap check of every scenario, the converted recording verified, a
+# headless screenshot), each image checked; written to a scratch directory, not docs/.
+viewer_out=$(mktemp -d)
+scripts/viewers/screenshots.sh "$viewer_out"
+rm -rf "$viewer_out"
