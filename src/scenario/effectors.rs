@@ -3,7 +3,7 @@
 //! Each list item is a one-key mapping naming the kind, e.g. `- hinged_rod: {mass: 0.139, …}`.
 //! Every physical parameter keeps its span, so an unphysical value is reported at its line.
 
-use super::{ScenarioError, Shape, loc};
+use super::{MAX_MAGNITUDE, MIN_POSITIVE, ScenarioError, Shape, loc};
 use crate::effectors::beam::{BeamProperties, beam_modes};
 use crate::effectors::{
     EnergySink, HingeFreedom, HingedRod, ModalBeam, ParticleEffector, Rayleigh, SpinUp, SpringMass,
@@ -244,25 +244,32 @@ impl Check<'_> {
     }
     fn positive(&self, s: &Spanned<f64>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
         let v = s.value;
-        if v.is_finite() && v > 0.0 {
+        if super::in_positive_range(v) {
             Ok(v)
         } else {
             Err(self.err(
                 s,
                 key,
-                format!("expected a positive, finite value ({unit}), got {v}"),
+                format!(
+                    "expected a positive value from {MIN_POSITIVE:e} to {MAX_MAGNITUDE:e} \
+                     ({unit}), got {}",
+                    super::number(v)
+                ),
             ))
         }
     }
     fn non_negative(&self, s: &Spanned<f64>, key: &str, unit: &str) -> Result<f64, ScenarioError> {
         let v = s.value;
-        if v.is_finite() && v >= 0.0 {
+        if (0.0..=MAX_MAGNITUDE).contains(&v) {
             Ok(v)
         } else {
             Err(self.err(
                 s,
                 key,
-                format!("expected a finite value ≥ 0 ({unit}), got {v}"),
+                format!(
+                    "expected a value from 0 to {MAX_MAGNITUDE:e} ({unit}), got {}",
+                    super::number(v)
+                ),
             ))
         }
     }
@@ -274,15 +281,26 @@ impl Check<'_> {
     ) -> Result<f64, ScenarioError> {
         match s {
             None => Ok(0.0),
-            Some(x) if x.value.is_finite() => Ok(x.value),
-            Some(x) => Err(self.err(x, key, format!("expected a finite value ({unit})"))),
+            Some(x) if x.value.abs() <= MAX_MAGNITUDE => Ok(x.value),
+            Some(x) => Err(self.err(
+                x,
+                key,
+                format!(
+                    "expected a value from -{MAX_MAGNITUDE:e} to {MAX_MAGNITUDE:e} ({unit}), got {}",
+                    x.value
+                ),
+            )),
         }
     }
     fn point(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
-        if s.value.iter().all(|x| x.is_finite()) {
+        if s.value.iter().all(|x| x.abs() <= MAX_MAGNITUDE) {
             Ok(Vector3::from(s.value))
         } else {
-            Err(self.err(s, key, "expected three finite numbers (m, body axes)"))
+            Err(self.err(
+                s,
+                key,
+                format!("expected three numbers within ±{MAX_MAGNITUDE:e} (m, body axes)"),
+            ))
         }
     }
     fn unit(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
@@ -548,13 +566,17 @@ pub(super) fn build(
                 let hinge = ck.on_body(&h.hinge, "hinge", cx.shape)?;
                 let pair = |s: &Spanned<PerAngle>, key: &str, unit: &str| {
                     let p = s.value.pair();
-                    if p.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                    if p.iter().all(|x| (0.0..=MAX_MAGNITUDE).contains(x)) {
                         Ok(p)
                     } else {
                         Err(ck.err(
                             s,
                             key,
-                            format!("expected a value ≥ 0 or [flap, lag] values ≥ 0 ({unit})"),
+                            format!(
+                                "expected a value from 0 to {MAX_MAGNITUDE:e}, or [flap, lag] \
+                                 values from 0 to {MAX_MAGNITUDE:e} ({unit}), got {}",
+                                p.map(super::number).join(", ")
+                            ),
                         ))
                     }
                 };
@@ -562,7 +584,7 @@ pub(super) fn build(
                 let damping = pair(&h.damping, "damping", "N m s/rad")?;
                 let finite2 = |s: &Option<Spanned<[f64; 2]>>, key: &str| match s {
                     None => Ok([0.0; 2]),
-                    Some(v) if v.value.iter().all(|x| x.is_finite()) => Ok(v.value),
+                    Some(v) if v.value.iter().all(|x| x.abs() <= MAX_MAGNITUDE) => Ok(v.value),
                     Some(v) => Err(ck.err(v, key, "expected [flap, lag], two finite numbers")),
                 };
                 let a0 = finite2(&h.initial_angles, "initial_angles")?;

@@ -65,7 +65,8 @@ impl std::error::Error for ScenarioError {}
 /// YAML, including a key of an inline `{…}` mapping on that line when the column points into
 /// one. Used only to name the field in error messages.
 pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
-    let mut stack: Vec<(usize, String)> = Vec::new();
+    // (indent, key, index of the sequence item under the key, if it holds a sequence)
+    let mut stack: Vec<(usize, String, Option<usize>)> = Vec::new();
     for (index, raw) in source.lines().enumerate() {
         let number = index as u32 + 1;
         if number > line {
@@ -78,7 +79,16 @@ pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
         }
         let mut indent = content.len() - trimmed.len();
         let mut rest = trimmed;
-        // A sequence item "- key: value" opens a mapping indented past the dash.
+        // A sequence item "- key: value" opens a mapping indented past the dash; it is the
+        // next item of the sequence under the nearest key to its left.
+        if rest.starts_with("- ") {
+            while stack.last().is_some_and(|(i, _, _)| *i > indent) {
+                stack.pop();
+            }
+            if let Some(parent) = stack.last_mut() {
+                parent.2 = Some(parent.2.map_or(0, |i| i + 1));
+            }
+        }
         while let Some(after) = rest.strip_prefix("- ") {
             indent += 2;
             rest = after.trim_start();
@@ -86,15 +96,15 @@ pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
         let Some(key) = block_key(rest) else {
             continue;
         };
-        while stack.last().is_some_and(|(i, _)| *i >= indent) {
+        while stack.last().is_some_and(|(i, _, _)| *i >= indent) {
             stack.pop();
         }
         if number == line && (column as usize) <= indent + 1 {
             // The error points at the key itself.
-            stack.push((indent, key.to_string()));
+            stack.push((indent, key.to_string(), None));
             break;
         }
-        stack.push((indent, key.to_string()));
+        stack.push((indent, key.to_string(), None));
         if number == line {
             // Inside a value on this line: find the innermost inline key up to the column,
             // including a key that starts at the column itself.
@@ -104,21 +114,25 @@ pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
             while end < chars.len() && !matches!(chars[end], ':' | ',' | '}' | ']') {
                 end += 1;
             }
-            let take = if chars.get(end) == Some(&':') {
-                end + 1
-            } else {
-                start
-            };
+            let take =
+                if chars.get(end) == Some(&':') && !matches!(chars.get(start), Some('{' | '[')) {
+                    end + 1
+                } else {
+                    start
+                };
             let upto: String = chars[..take].iter().collect();
             let after_key = upto.split_once(':').map(|x| x.1).unwrap_or("");
             if let Some(k) = last_inline_key(after_key) {
-                stack.push((usize::MAX, k));
+                stack.push((usize::MAX, k, None));
             }
         }
     }
     stack
         .into_iter()
-        .map(|(_, k)| k)
+        .map(|(_, k, item)| match item {
+            Some(i) => format!("{k}[{i}]"),
+            None => k,
+        })
         .collect::<Vec<_>>()
         .join(".")
 }
@@ -170,8 +184,18 @@ mod tests {
         assert_eq!(field_path_at(YAML, 6, 33), "initial.attitude.q");
         // A key that starts at the column (serde-saphyr points there for missing fields).
         assert_eq!(field_path_at(YAML, 6, 23), "initial.attitude.x");
-        assert_eq!(field_path_at(YAML, 8, 5), "stop.nutation_angle_deg");
+        assert_eq!(field_path_at(YAML, 8, 5), "stop[0].nutation_angle_deg");
         assert_eq!(field_path_at(YAML, 1, 1), "name");
+    }
+
+    #[test]
+    fn paths_count_sequence_items() {
+        let y = "effectors:\n  - rod:\n      mass: 1\n  - beam:\n      length: 2\n      \
+                 EI: 3\nnext:\n- a: 1\n- b: 2\n";
+        assert_eq!(field_path_at(y, 3, 7), "effectors[0].rod.mass");
+        assert_eq!(field_path_at(y, 6, 7), "effectors[1].beam.EI");
+        // A sequence at the key's own indent.
+        assert_eq!(field_path_at(y, 9, 3), "next[1].b");
     }
 
     #[test]

@@ -25,6 +25,19 @@ use std::path::{Path, PathBuf};
 pub const MAX_SAMPLES: f64 = 5e7;
 /// Largest scenario file accepted (bytes).
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
+/// Largest magnitude of a physical parameter in SI units (masses, lengths, inertia moments,
+/// stiffnesses, damping, ...). Far beyond any spacecraft, and small enough that energies and
+/// momenta built from such values stay finite in double precision.
+pub const MAX_MAGNITUDE: f64 = 1e12;
+/// Smallest positive value of a parameter that must be positive (masses, lengths, inertia
+/// moments, stiffnesses): below it the equations divide by numbers that round to nothing.
+pub const MIN_POSITIVE: f64 = 1e-12;
+/// Largest initial body rate |ω| (rad/s), about 95 000 rev/min.
+pub const MAX_RATE: f64 = 1e4;
+/// Shortest run (s): the log stamps time in nanoseconds.
+pub const MIN_DURATION: f64 = 1e-9;
+/// Longest scenario name (characters); the name becomes the default log's file name.
+pub const MAX_NAME_CHARS: usize = 200;
 /// Default epoch of sim time 0: J2000, 2000-01-01T12:00:00Z.
 pub const DEFAULT_EPOCH: &str = "2000-01-01T12:00:00Z";
 
@@ -524,6 +537,12 @@ pub struct Overrides {
 pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioError> {
     let meta = std::fs::metadata(path)
         .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
+    if meta.is_dir() {
+        return Err(ScenarioError::whole_file(
+            path,
+            "this is a directory; expected a scenario file (YAML)",
+        ));
+    }
     if meta.len() > MAX_FILE_BYTES {
         return Err(ScenarioError::whole_file(
             path,
@@ -535,6 +554,15 @@ pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioErro
     }
     let bytes = std::fs::read(path)
         .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(ScenarioError::at(
+            path,
+            Some((1, 1)),
+            "",
+            "the file is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as \
+             UTF-8",
+        ));
+    }
     let source = String::from_utf8(bytes).map_err(|e| {
         let offset = e.utf8_error().valid_up_to();
         let before = &e.as_bytes()[..offset];
@@ -549,7 +577,10 @@ pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioErro
             path,
             Some((line, column)),
             "",
-            "the file is not valid UTF-8 text (expected a YAML file)",
+            format!(
+                "byte 0x{:02x} is not UTF-8 text; save the file as UTF-8",
+                e.as_bytes()[offset]
+            ),
         )
     })?;
     parse(path, source, overrides)
@@ -600,8 +631,75 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
     {
         return ScenarioError::at(path, None, "", format!("the file is empty: {TOP_LEVEL}"));
     }
-    if message.contains("expected mapping start") && location.is_some_and(|l| l.0 == 1) {
+    let not_a_mapping =
+        message.contains("expected mapping start") && location.is_some_and(|l| l.0 == 1);
+    if not_a_mapping {
         message = format!("the document is not a mapping: {TOP_LEVEL}");
+    }
+    // A syntax error is about the text, not about a field: say what is likely open.
+    let syntax = matches!(
+        e.without_snippet(),
+        serde_saphyr::Error::ExternalMessage { .. } | serde_saphyr::Error::Eof { .. }
+    );
+    if syntax && let Some((line, _)) = location {
+        if let Some(hint) = unclosed_before(source, line) {
+            message = format!("{message} ({hint})");
+        }
+        if message.starts_with("tabs disallowed") {
+            message = "a tab in the indentation: YAML indents with spaces".into();
+        } else if message.contains("did not find expected key") {
+            message = format!(
+                "{message}: check this line's indentation against the lines above (keys of \
+                 one mapping start in the same column)"
+            );
+        } else if message.starts_with("mapping values are not allowed") {
+            message = "a `:` inside a value: quote the value (\"a: b\"), or check the \
+                       indentation"
+                .into();
+        }
+        if message.contains("\\u{0}") {
+            message = "a NUL byte: YAML text may not contain control characters".into();
+        }
+    }
+    let mut field = if syntax || not_a_mapping {
+        String::new()
+    } else {
+        location
+            .map(|(l, c)| field_path_at(source, l, c))
+            .unwrap_or_default()
+    };
+    // The text of the offending scalar, for type errors.
+    let found = location
+        .and_then(|(l, c)| scalar_at(source, l, c))
+        .map(|t| format!(", got `{t}`"))
+        .unwrap_or_default();
+    if message == "invalid floating point" || message.starts_with("invalid floating point") {
+        message = format!(
+            "expected a number{found} (plain numbers in SI units, no unit suffix; angles in \
+             radians unless the key ends in `_deg`)"
+        );
+    } else if message == "expected sequence start" {
+        message = format!("expected a list `[...]`{found}");
+    } else if message == "expected string scalar" {
+        message = "expected a text string".into();
+    } else if message.starts_with("recursion limit exceeded") {
+        message = "the YAML nests deeper than the parser allows (a scenario nests a few \
+                   levels; is a bracket repeated?)"
+            .into();
+        field.clear();
+    } else if message.starts_with("multiple YAML documents") {
+        message = "a second YAML document starts here (`---`); a scenario file holds one \
+                   document"
+            .into();
+        field.clear();
+    } else if let Some(rest) = message.strip_prefix("invalid length ")
+        && let Some((got, expected)) = rest.split_once(", expected ")
+        && let Some(n) = expected.split_whitespace().last()
+    {
+        message = format!("expected a list of {n} values, got {got}");
+    } else if let Some(rest) = message.strip_prefix("duplicate mapping key: ") {
+        let key = rest.split(',').next().unwrap_or(rest).trim();
+        message = format!("`{key}` is given twice; a key may appear once in a mapping");
     }
     // "unknown field `x`, expected one of a, b" → suggest the nearest valid name.
     if message.starts_with("unknown")
@@ -616,9 +714,6 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
             message = format!("{message}; did you mean `{best}`?");
         }
     }
-    let mut field = location
-        .map(|(l, c)| field_path_at(source, l, c))
-        .unwrap_or_default();
     // "missing field `x`": the location is a sibling key, so the field is its parent's `x`.
     if let Some(missing) = message
         .strip_prefix("missing field `")
@@ -635,12 +730,107 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
     ScenarioError::at(path, location, field, message)
 }
 
+/// Where a bracket or quote opened before `line` (1-based) is still open, for syntax errors
+/// reported later than their cause (YAML flow lists and quoted text may span lines).
+fn unclosed_before(source: &str, line: u32) -> Option<String> {
+    let mut open: Vec<(char, u32)> = Vec::new();
+    for (i, raw) in source
+        .lines()
+        .enumerate()
+        .take(line.saturating_sub(1) as usize)
+    {
+        let number = i as u32 + 1;
+        let mut quote: Option<char> = None;
+        let mut prev = ' ';
+        for c in raw.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '#') if prev == ' ' || prev == '\t' => break,
+                (None, '"') => quote = Some('"'),
+                (None, '\'') if prev == ' ' || prev == ':' || prev == '[' || prev == ',' => {
+                    quote = Some('\'')
+                }
+                (None, '[' | '{') => open.push((c, number)),
+                (None, ']' | '}') => {
+                    open.pop();
+                }
+                _ => {}
+            }
+            prev = c;
+        }
+        if let Some(q) = quote {
+            return Some(format!("is the `{q}` opened on line {number} closed?"));
+        }
+    }
+    open.last()
+        .map(|(c, l)| format!("is the `{c}` opened on line {l} closed?"))
+}
+
+/// The scalar text starting at (`line`, `column`), 1-based, up to a flow indicator, comment or
+/// the end of the line; `None` when empty or not a plain scalar.
+fn scalar_at(source: &str, line: u32, column: u32) -> Option<String> {
+    let text = source.lines().nth(line.checked_sub(1)? as usize)?;
+    let rest: String = text
+        .chars()
+        .skip(column.checked_sub(1)? as usize)
+        .take_while(|c| !matches!(c, ',' | ']' | '}' | '#' | '[' | '{'))
+        .collect();
+    let rest = rest.trim();
+    (!rest.is_empty() && rest.chars().count() <= 60).then(|| rest.to_string())
+}
+
 pub(crate) fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
     Some((s.referenced.line() as u32, s.referenced.column() as u32))
 }
 
 fn finite3(v: &[f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())
+}
+
+/// Whether `v` is a positive parameter polhode supports ([`MIN_POSITIVE`] to
+/// [`MAX_MAGNITUDE`]).
+pub fn in_positive_range(v: f64) -> bool {
+    (MIN_POSITIVE..=MAX_MAGNITUDE).contains(&v)
+}
+
+/// `v` for a message: plain when of moderate size, in exponent form when very large or small.
+pub fn number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// Refuses initial body rates beyond [`MAX_RATE`].
+fn check_rate(w: &Vector3<f64>) -> Result<(), String> {
+    // Scaled, so that huge components do not overflow the norm.
+    let m = w.amax();
+    let n = if m > 0.0 { m * (w / m).norm() } else { 0.0 };
+    if n > MAX_RATE {
+        Err(format!(
+            "|ω| = {n:e} rad/s is beyond the {MAX_RATE:e} rad/s polhode supports (is it in \
+             deg/s or rev/min? `omega` is rad/s, `omega_rpm` rev/min)"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// Where the top-level `key:` is written (line, column), for errors about what it lacks.
+fn key_location(source: &str, key: &str) -> Option<(u32, u32)> {
+    source
+        .lines()
+        .position(|l| {
+            l.strip_prefix(key)
+                .is_some_and(|r| r.trim_start().starts_with(':'))
+        })
+        .map(|i| (i as u32 + 1, 1))
+}
+
+fn loc_of<T>(s: &Option<Spanned<T>>) -> Option<(u32, u32)> {
+    s.as_ref().and_then(loc)
 }
 
 impl ScenarioFile {
@@ -660,6 +850,17 @@ impl ScenarioFile {
                 loc(&self.name),
                 "name",
                 "expected a non-empty name".into(),
+            ));
+        }
+        if name.chars().count() > MAX_NAME_CHARS {
+            return Err(err(
+                loc(&self.name),
+                "name",
+                format!(
+                    "the name has {} characters; expected at most {MAX_NAME_CHARS} (it names \
+                     the log file)",
+                    name.chars().count()
+                ),
             ));
         }
 
@@ -685,7 +886,7 @@ impl ScenarioFile {
             ),
             (None, None) => {
                 return Err(err(
-                    None,
+                    key_location(&source, "body"),
                     "body",
                     "missing the mass properties: expected `inertia: [[..],[..],[..]]` \
                      (kg m²) or `principal: [I1, I2, I3]`"
@@ -693,6 +894,18 @@ impl ScenarioFile {
                 ));
             }
         };
+        let largest = inertia.amax();
+        if largest.is_finite() && !(MIN_POSITIVE..=MAX_MAGNITUDE).contains(&largest) {
+            return Err(err(
+                inertia_loc,
+                inertia_field,
+                format!(
+                    "the largest entry is {largest:e} kg m²; inertia moments must lie from \
+                     {MIN_POSITIVE:e} to {MAX_MAGNITUDE:e} kg m² (SI units: is it in g cm² or \
+                     another unit?)"
+                ),
+            ));
+        }
         let hub = RigidBody::new(inertia).map_err(|e| {
             err(
                 inertia_loc,
@@ -718,7 +931,9 @@ impl ScenarioFile {
                         "expected three finite numbers (rad/s)".into(),
                     ));
                 }
-                Vector3::from(w.value)
+                let w = Vector3::from(w.value);
+                check_rate(&w).map_err(|m| err(loc_of(&self.initial.omega), "initial.omega", m))?;
+                w
             }
             (None, Some(r)) => {
                 if !finite3(&r.value) {
@@ -728,11 +943,14 @@ impl ScenarioFile {
                         "expected three finite numbers (rev/min)".into(),
                     ));
                 }
-                Vector3::from(r.value) * (2.0 * std::f64::consts::PI / 60.0)
+                let w = Vector3::from(r.value) * (2.0 * std::f64::consts::PI / 60.0);
+                check_rate(&w)
+                    .map_err(|m| err(loc_of(&self.initial.omega_rpm), "initial.omega_rpm", m))?;
+                w
             }
             (None, None) => {
                 return Err(err(
-                    None,
+                    key_location(&source, "initial"),
                     "initial",
                     "missing the body rates: expected `omega: [wx, wy, wz]` (rad/s) or \
                      `omega_rpm: [..]`"
@@ -804,7 +1022,20 @@ impl ScenarioFile {
             return Err(err(
                 duration_loc,
                 duration_field,
-                format!("expected a positive, finite number of seconds, got {duration}"),
+                format!(
+                    "expected a positive, finite number of seconds, got {}",
+                    number(duration)
+                ),
+            ));
+        }
+        if duration < MIN_DURATION {
+            return Err(err(
+                duration_loc,
+                duration_field,
+                format!(
+                    "{duration:e} s is shorter than the log's time resolution; expected at \
+                     least {MIN_DURATION:e} s"
+                ),
             ));
         }
 
@@ -1130,11 +1361,15 @@ impl ScenarioFile {
 
         let mut spacecraft = Spacecraft::new(hub, spin_axis);
         if let Some(m) = &self.body.mass {
-            if !(m.value.is_finite() && m.value > 0.0) {
+            if !in_positive_range(m.value) {
                 return Err(err(
                     loc(m),
                     "body.mass",
-                    format!("expected a positive, finite mass (kg), got {}", m.value),
+                    format!(
+                        "expected a positive mass from {MIN_POSITIVE:e} to {MAX_MAGNITUDE:e} \
+                         kg, got {}",
+                        m.value
+                    ),
                 ));
             }
             spacecraft.hub_mass = Some(m.value);
