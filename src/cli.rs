@@ -15,6 +15,18 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// A write beyond the file-size limit (`ulimit -f`) raises SIGXFSZ, which by default kills the
+/// process with a half-written temporary file; ignored, the write fails with EFBIG instead and
+/// the run reports it like a full disk and cleans up.
+fn ignore_file_size_signal() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to SIG_IGN at start-up, before any thread exists,
+    // has no preconditions.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
 /// Exit code for bad input.
 pub const EXIT_BAD_INPUT: i32 = 2;
 /// Exit code for an I/O failure during a run.
@@ -55,6 +67,10 @@ enum Command {
         /// Write a JSON summary here.
         #[arg(long)]
         summary: Option<PathBuf>,
+        /// Largest log to write (MB, 10⁶ bytes; overrides `output.max_log_mb`, default 2000):
+        /// a run whose log is estimated larger is refused before it starts.
+        #[arg(long, value_name = "MB")]
+        max_log_mb: Option<f64>,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
@@ -246,12 +262,14 @@ impl MethodArgs {
             order: self.order,
             duration,
             mcap,
+            max_log_mb: None,
         }
     }
 }
 
 /// Runs the command line; returns the process exit code.
 pub fn main() -> i32 {
+    ignore_file_size_signal();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -294,9 +312,13 @@ pub fn main() -> i32 {
             method,
             duration,
             summary,
+            max_log_mb,
             quiet,
         } => {
-            let overrides = method.overrides(duration, out);
+            let overrides = Overrides {
+                max_log_mb,
+                ..method.overrides(duration, out)
+            };
             run(&scenario, &overrides, no_log, summary.as_deref(), quiet)
         }
     }
@@ -787,6 +809,31 @@ fn run(
             }
         }
     };
+    if let Some(l) = logger.as_mut() {
+        let estimate_mb = l.estimate_bytes(&s) / 1e6;
+        if estimate_mb > s.max_log_mb {
+            eprintln!(
+                "error: {}: the log would be about {} MB before compression \
+                 ({:.3e} samples at {} Hz over {} s), above the limit of {} MB; lower \
+                 `output.rate` (or `output.scene_rate`), shorten the run, or raise the limit \
+                 with `output.max_log_mb` or --max-log-mb",
+                s.path.display(),
+                match estimate_mb {
+                    x if x >= 100.0 => format!("{x:.0}"),
+                    x if x >= 1.0 => format!("{x:.1}"),
+                    x => format!("{x:.3}"),
+                },
+                (s.duration * s.output_rate).floor() + 1.0,
+                s.output_rate,
+                s.duration,
+                s.max_log_mb
+            );
+            if let Some(l) = logger {
+                l.abandon();
+            }
+            return EXIT_BAD_INPUT;
+        }
+    }
 
     let interrupt = Arc::new(AtomicBool::new(false));
     {
@@ -858,6 +905,9 @@ fn run(
     if !quiet {
         print_summary(&s, &outcome, written.as_deref());
     }
+    for w in &outcome.warnings {
+        eprintln!("warning: {}", w.message);
+    }
     match &outcome.status {
         Status::Completed | Status::Stopped { .. } => 0,
         Status::Interrupted => {
@@ -906,6 +956,9 @@ struct Summary<'a> {
     samples: u64,
     wall_time_s: f64,
     events: &'a [sim::EventRecord],
+    /// Events beyond the first 10 000 (logged, not listed here).
+    events_not_kept: u64,
+    warnings: &'a [sim::Warning],
 }
 
 /// An effector as built from the scenario.
@@ -1025,6 +1078,8 @@ fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         samples: o.samples,
         wall_time_s: o.wall_time,
         events: &o.events,
+        events_not_kept: o.events_not_kept,
+        warnings: &o.warnings,
     };
     serde_json::to_string_pretty(&summary).unwrap_or_default() + "\n"
 }
@@ -1281,7 +1336,13 @@ fn montecarlo_cmd(
         match montecarlo::output::write_outputs(&dir, &prep, &rows, shard, partial, &interrupt) {
             Ok(w) => w,
             Err(e) => {
-                eprintln!("error: {e}");
+                eprintln!(
+                    "error: {e}; the campaign's outputs in {} are incomplete: the files written \
+                     before this one are whole, but the manifest campaign.json was not written, \
+                     so `merge` refuses the directory (a re-run with the same seed writes the \
+                     same result)",
+                    dir.display()
+                );
                 return EXIT_IO;
             }
         };
@@ -1351,7 +1412,10 @@ fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
         match montecarlo::output::write_outputs(out, &prep, &rows, None, false, &interrupt) {
             Ok(w) => w,
             Err(e) => {
-                eprintln!("error: {e}");
+                eprintln!(
+                    "error: {e}; the merged result in {} is incomplete (no campaign.json)",
+                    out.display()
+                );
                 return EXIT_IO;
             }
         };

@@ -430,6 +430,9 @@ fn interrupt_keeps_a_valid_partial_log() {
             file.to_str().unwrap(),
             "--out",
             mcap.to_str().unwrap(),
+            // The whole 1e6 s would be a 2 GB log; it is interrupted long before.
+            "--max-log-mb",
+            "1e5",
         ])
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())

@@ -193,6 +193,7 @@ fn overrides(m: &MethodSpec, knob: Option<f64>) -> Overrides {
         order: m.order,
         duration: None,
         mcap: None,
+        max_log_mb: None,
     }
 }
 

@@ -124,6 +124,7 @@ pub fn load_with(
         order: method.order,
         duration,
         mcap: None,
+        max_log_mb: None,
     };
     scenario::load(path, &overrides).map_err(|e| e.to_string())
 }

@@ -182,7 +182,11 @@ fn register(
 }
 
 fn io_err(e: mcap::McapError) -> io::Error {
-    io::Error::other(e.to_string())
+    match e {
+        // Keep the operating system's error (and its kind: disk full, file too large).
+        mcap::McapError::Io(e) => with_hint(e),
+        other => io::Error::other(other.to_string()),
+    }
 }
 
 fn add<T: Encode>(w: &mut mcap::Writer<BufWriter<File>>, topic: &str) -> io::Result<u16> {
@@ -455,6 +459,75 @@ impl<'a> McapLogger<'a> {
         Ok(final_path)
     }
 
+    /// Estimated size of the finished log (bytes, before chunk compression) for `scenario`
+    /// run to its end: every message of the first sample encoded as the run will encode it,
+    /// times the number of samples and scene updates, plus MCAP's per-message record and index
+    /// (47 bytes) and the summary, schemas and attachments, with a 10 % margin. Compression
+    /// only makes the file smaller.
+    pub fn estimate_bytes(&mut self, scenario: &Scenario) -> f64 {
+        const PER_MESSAGE: f64 = 47.0;
+        let sc = self.spacecraft;
+        // A generic state: protobuf leaves zero fields out, so the initial state (often an
+        // identity attitude, rates about one axis) would encode shorter than later ones.
+        let mut y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
+        let spin = scenario.omega0.norm().max(1e-3);
+        for w in &mut y0[0..3] {
+            *w += 0.01 * spin;
+        }
+        y0[3..7].copy_from_slice(&[0.5; 4]);
+        let o = sc.observe(0.0, &y0);
+        let inv = Reference::of(&o);
+        let q = o.attitude;
+        let tf = fg::FrameTransforms {
+            transforms: vec![fg::FrameTransform {
+                timestamp: Some(self.timestamp(0.0)),
+                parent_frame_id: WORLD_FRAME.into(),
+                child_frame_id: self.body_frame.clone(),
+                translation: Some(fg::Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                }),
+                rotation: Some(fg::Quaternion {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                }),
+            }],
+        };
+        let mut per_sample = self.encoded_len(&tf) + PER_MESSAGE;
+        telemetry::encode_doubles(&telemetry::values(&o, &inv), &mut self.buf);
+        per_sample += self.buf.len() as f64 + PER_MESSAGE;
+        let hub = HubState {
+            t: 0.0,
+            omega: o.omega,
+            attitude: &y0[3..7],
+        };
+        for (k, e) in sc.effectors().iter().enumerate() {
+            let mut values = vec![0.0];
+            values.extend(e.telemetry(&hub, sc.effector_states(k, &y0)));
+            telemetry::encode_doubles(&values, &mut self.buf);
+            per_sample += self.buf.len() as f64 + PER_MESSAGE;
+        }
+        let scene = self.scene_update(&o, &y0);
+        let per_scene = self.encoded_len(&scene) + PER_MESSAGE;
+        let samples = (scenario.duration * scenario.output_rate).floor() + 2.0;
+        let scenes =
+            (scenario.duration * scenario.scene_rate.min(scenario.output_rate)).floor() + 2.0;
+        let fixed = 64.0 * 1024.0 + 2.0 * scenario.source.len() as f64;
+        // Scene updates grow as appendages deflect: uncompressed logs of the shipped scenarios
+        // measured 0.76–1.05 times the raw figure (docs/reliability.md); 10 % covers that.
+        1.1 * (samples * per_sample + scenes * per_scene) + fixed
+    }
+
+    fn encoded_len<T: Encode>(&mut self, msg: &T) -> f64 {
+        self.buf.clear();
+        // Encoding into a Vec cannot fail for want of space; a failure would show as 0.
+        let _ = msg.encode(&mut self.buf);
+        self.buf.len() as f64
+    }
+
     /// Removes the temporary file (after an error that leaves nothing worth keeping).
     pub fn abandon(self) {
         drop(self);
@@ -701,6 +774,14 @@ impl Sink for McapLogger<'_> {
         );
         self.log_text(e.t, fg::log::Level::Info, &text)
     }
+
+    fn warning(&mut self, w: &crate::sim::Warning) -> io::Result<()> {
+        self.log_text(
+            w.t,
+            fg::log::Level::Warning,
+            &format!("warning: {}", w.message),
+        )
+    }
 }
 
 /// Writes `bytes` to `path` through a temporary file and a rename.
@@ -723,5 +804,21 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    result
+    result.map_err(with_hint)
+}
+
+/// Adds what to do to an out-of-space error (disk full, quota, file-size limit), keeping its
+/// kind.
+pub fn with_hint(e: io::Error) -> io::Error {
+    use io::ErrorKind::{FileTooLarge, QuotaExceeded, StorageFull};
+    if matches!(e.kind(), StorageFull | FileTooLarge | QuotaExceeded) {
+        io::Error::new(
+            e.kind(),
+            format!(
+                "{e}: out of space (disk full, quota or file-size limit); free space, or lower the output rate"
+            ),
+        )
+    } else {
+        e
+    }
 }

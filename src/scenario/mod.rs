@@ -36,6 +36,12 @@ pub const MIN_POSITIVE: f64 = 1e-12;
 pub const MAX_RATE: f64 = 1e4;
 /// Shortest run (s): the log stamps time in nanoseconds.
 pub const MIN_DURATION: f64 = 1e-9;
+/// Default largest log (MB): a run whose log is estimated to be larger is refused before it
+/// starts (`output.max_log_mb`, `--max-log-mb`).
+pub const DEFAULT_MAX_LOG_MB: f64 = 2000.0;
+/// Smallest absolute tolerance: below it the scaled error norm overflows for components
+/// near zero, and the error test (and radau5's Newton test) can never pass.
+pub const MIN_ATOL: f64 = 1e-30;
 /// Longest scenario name (characters); the name becomes the default log's file name.
 pub const MAX_NAME_CHARS: usize = 200;
 /// Default epoch of sim time 0: J2000, 2000-01-01T12:00:00Z.
@@ -80,6 +86,60 @@ pub struct ScenarioFile {
     /// A Monte Carlo campaign over this scenario (`polhode montecarlo`; ignored by `run`).
     #[serde(default)]
     pub montecarlo: Option<crate::montecarlo::CampaignFile>,
+    /// Bounds on invariant drift and what to do when one is exceeded.
+    #[serde(default)]
+    pub checks: Option<ChecksSpec>,
+}
+
+/// `checks:` — accuracy the run must keep, checked at every step.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChecksSpec {
+    /// Largest relative drift of each conserved invariant.
+    #[serde(default)]
+    pub max_drift: Option<DriftBoundsSpec>,
+    /// `stop` (default: end the run, keep the log, exit 3) or `warn` (note it and go on).
+    #[serde(default)]
+    pub on_drift: Option<Spanned<String>>,
+}
+
+/// `checks.max_drift:` bounds (dimensionless, relative to the initial value).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriftBoundsSpec {
+    /// Angular momentum: max of |ΔH|/|H₀| (body |H|) and |ΔH_N|/|H₀| (inertial vector).
+    #[serde(default)]
+    pub momentum: Option<Spanned<f64>>,
+    /// Energy balance (kinetic + elastic + dissipated): |ΔE|/E₀.
+    #[serde(default)]
+    pub energy: Option<Spanned<f64>>,
+    /// Quaternion norm: ||q| − 1|.
+    #[serde(default)]
+    pub quaternion_norm: Option<Spanned<f64>>,
+}
+
+/// What the run does when an invariant drifts beyond its bound.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OnDrift {
+    /// End the run as failed (the log up to there is kept, marked partial).
+    #[default]
+    Stop,
+    /// Print and log a warning once per invariant, and go on.
+    Warn,
+}
+
+/// Bounds on invariant drift checked after every step (`checks:`); `None` is unchecked.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct DriftLimits {
+    /// Relative angular-momentum drift bound.
+    pub momentum: Option<f64>,
+    /// Relative energy-balance drift bound.
+    pub energy: Option<f64>,
+    /// Bound on ||q| − 1|.
+    pub quaternion_norm: Option<f64>,
+    /// Stop or warn.
+    pub on_drift: OnDrift,
 }
 
 /// `body:` mass properties and display.
@@ -198,6 +258,10 @@ pub struct OutputSpec {
     /// `none` (fastest, largest).
     #[serde(default)]
     pub compression: Option<Compression>,
+    /// Largest log a run may write (MB = 10⁶ bytes, estimated before the run starts; default
+    /// [`DEFAULT_MAX_LOG_MB`]).
+    #[serde(default)]
+    pub max_log_mb: Option<Spanned<f64>>,
 }
 
 /// MCAP chunk compression.
@@ -510,6 +574,10 @@ pub struct Scenario {
     pub shape: Shape,
     /// The `montecarlo:` block as written, checked by `montecarlo::Campaign::new`.
     pub montecarlo: Option<crate::montecarlo::CampaignFile>,
+    /// Drift bounds checked at every step (`checks:`).
+    pub drift_limits: DriftLimits,
+    /// Largest log the run may write (MB), checked against an estimate before it starts.
+    pub max_log_mb: f64,
 }
 
 /// Overrides from the command line, applied before validation.
@@ -531,6 +599,8 @@ pub struct Overrides {
     pub duration: Option<f64>,
     /// `--out`.
     pub mcap: Option<PathBuf>,
+    /// `--max-log-mb`.
+    pub max_log_mb: Option<f64>,
 }
 
 /// Reads and validates a scenario file.
@@ -816,6 +886,66 @@ fn check_rate(w: &Vector3<f64>) -> Result<(), String> {
     } else {
         Ok(())
     }
+}
+
+/// Checks the `checks:` block against what the spacecraft conserves.
+fn drift_limits(
+    path: &Path,
+    checks: Option<ChecksSpec>,
+    sc: &Spacecraft,
+) -> Result<DriftLimits, ScenarioError> {
+    let Some(checks) = checks else {
+        return Ok(DriftLimits::default());
+    };
+    let on_drift = match &checks.on_drift {
+        None => OnDrift::Stop,
+        Some(a) if a.value == "stop" => OnDrift::Stop,
+        Some(a) if a.value == "warn" => OnDrift::Warn,
+        Some(a) => {
+            return Err(ScenarioError::at(
+                path,
+                loc(a),
+                "checks.on_drift",
+                format!("expected `stop` or `warn`, got `{}`", a.value),
+            ));
+        }
+    };
+    let bounds = checks.max_drift.unwrap_or_default();
+    let bound = |b: &Option<Spanned<f64>>, key: &str, conserved: bool, why: &str| match b {
+        None => Ok(None),
+        Some(v) if !conserved => Err(ScenarioError::at(
+            path,
+            loc(v),
+            format!("checks.max_drift.{key}"),
+            format!("this scene does not conserve it ({why}), so no drift bound applies"),
+        )),
+        Some(v) if v.value.is_finite() && v.value > 0.0 => Ok(Some(v.value)),
+        Some(v) => Err(ScenarioError::at(
+            path,
+            loc(v),
+            format!("checks.max_drift.{key}"),
+            format!(
+                "expected a positive relative drift (e.g. 1.0e-8), got {}",
+                number(v.value)
+            ),
+        )),
+    };
+    Ok(DriftLimits {
+        momentum: bound(
+            &bounds.momentum,
+            "momentum",
+            sc.conserves_momentum(),
+            "its hub's rotation is prescribed",
+        )?,
+        energy: bound(
+            &bounds.energy,
+            "energy",
+            sc.conserves_energy(),
+            "a prescribed motion does work on it",
+        )?,
+        quaternion_norm: bound(&bounds.quaternion_norm, "quaternion_norm", true, "")?,
+        on_drift,
+    })
 }
 
 /// Where the top-level `key:` is written (line, column), for errors about what it lacks.
@@ -1271,6 +1401,25 @@ impl ScenarioFile {
             ));
         }
 
+        if let Some(Adaptive { atol, .. }) = method.adaptive()
+            && atol < MIN_ATOL
+        {
+            let (l, f) = from(
+                ov.atol,
+                spec.atol.as_ref().and_then(loc),
+                "integrator.atol",
+                "--atol",
+            );
+            return Err(err(
+                l,
+                f,
+                format!(
+                    "atol {atol:e} is below {MIN_ATOL:e}: the error of a component near zero, \
+                     divided by it, overflows; use at least {MIN_ATOL:e}"
+                ),
+            ));
+        }
+
         // Output.
         let out = self.output.unwrap_or_default();
         let output_rate = match &out.rate {
@@ -1457,6 +1606,27 @@ impl ScenarioFile {
             (method, None)
         };
 
+        let drift_limits = drift_limits(path, self.checks, &spacecraft)?;
+        let max_log_mb = match (ov.max_log_mb, &out.max_log_mb) {
+            (Some(v), _) if v.is_finite() && v > 0.0 => v,
+            (Some(v), _) => {
+                return Err(err(
+                    None,
+                    "--max-log-mb",
+                    format!("expected a positive number of megabytes, got {v}"),
+                ));
+            }
+            (None, Some(m)) if m.value.is_finite() && m.value > 0.0 => m.value,
+            (None, Some(m)) => {
+                return Err(err(
+                    loc(m),
+                    "output.max_log_mb",
+                    format!("expected a positive number of megabytes, got {}", m.value),
+                ));
+            }
+            (None, None) => DEFAULT_MAX_LOG_MB,
+        };
+
         Ok(Scenario {
             path: path.to_path_buf(),
             source,
@@ -1477,6 +1647,8 @@ impl ScenarioFile {
             events,
             shape,
             montecarlo: self.montecarlo,
+            drift_limits,
+            max_log_mb,
         })
     }
 }

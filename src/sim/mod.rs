@@ -11,7 +11,7 @@ pub use methods::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
 
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
-use crate::scenario::{Condition, Method, Scenario};
+use crate::scenario::{Condition, DriftLimits, Method, OnDrift, Scenario};
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -123,6 +123,10 @@ pub trait Sink {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()>;
     /// An event, at its located time.
     fn event(&mut self, e: &EventRecord, o: &Observation) -> std::io::Result<()>;
+    /// A warning (the run goes on).
+    fn warning(&mut self, _w: &Warning) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// A sink that discards everything (runs without logging).
@@ -145,6 +149,16 @@ pub struct Control<'a> {
     pub progress: Option<&'a mut dyn FnMut(f64)>,
 }
 
+/// Something the run noticed and went on from (e.g. drift beyond a `checks:` bound with
+/// `on_drift: warn`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Warning {
+    /// Sim time (s).
+    pub t: f64,
+    /// What, the state, and what to do.
+    pub message: String,
+}
+
 /// What a run did.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Outcome {
@@ -162,8 +176,12 @@ pub struct Outcome {
     pub stats: Stats,
     /// Invariant drift over the run.
     pub drift: Drift,
-    /// Events in time order.
+    /// Events in time order (the first [`MAX_EVENTS_KEPT`]; all are logged).
     pub events: Vec<EventRecord>,
+    /// Events beyond [`MAX_EVENTS_KEPT`], logged but not kept in memory.
+    pub events_not_kept: u64,
+    /// Warnings, in time order.
+    pub warnings: Vec<Warning>,
     /// Output samples emitted.
     pub samples: u64,
     /// Wall-clock time of the integration loop, including the sink (s).
@@ -193,6 +211,8 @@ pub fn run(scenario: &Scenario, sink: &mut dyn Sink, ctl: Control) -> std::io::R
                 stats: Stats::default(),
                 drift: Drift::default(),
                 events: vec![],
+                events_not_kept: 0,
+                warnings: vec![],
                 samples: 0,
                 wall_time: 0.0,
             })
@@ -263,6 +283,18 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
 /// finite and the diagnosis can measure the stiffness there.
 pub const DIVERGENCE_ENERGY_REL: f64 = 0.5;
 
+/// Events kept in [`Outcome::events`]; later ones are logged but only counted, so that an
+/// event that fires every period of a very long run cannot use unbounded memory.
+pub const MAX_EVENTS_KEPT: usize = 10_000;
+
+/// A run whose step size has collapsed so far that finishing would take more than this many
+/// steps stops as failed (the same bound the scenario checks put on the work a file may ask
+/// for): a singularity of the model, or stiffness an explicit method crawls through.
+pub const MAX_STEPS_TO_GO: f64 = 1e11;
+
+/// Steps over which the average step size is measured for [`MAX_STEPS_TO_GO`].
+const COLLAPSE_WINDOW: u64 = 100_000;
+
 /// How often (in steps) the interrupt flag and the wall clock are looked at.
 const POLL_STEPS: u64 = 64;
 
@@ -284,6 +316,12 @@ fn drive<M: Stepper>(
     let inv = Reference::of(&o0);
     let mut drift = Drift::default();
     let mut events: Vec<EventRecord> = Vec::new();
+    let mut events_not_kept = 0u64;
+    let mut warnings: Vec<Warning> = Vec::new();
+    // Invariants already warned about (momentum, energy, quaternion norm).
+    let mut warned = [false; 3];
+    let limits = scenario.drift_limits;
+    let mut window = (0u64, 0.0f64);
     let conditions: Vec<(&Condition, bool)> = scenario
         .stop
         .iter()
@@ -307,7 +345,7 @@ fn drive<M: Stepper>(
                 terminal: *terminal,
             };
             sink.event(&e, &o0)?;
-            events.push(e);
+            keep_event(&mut events, &mut events_not_kept, e);
             if *terminal && status.is_none() {
                 status = Some(Status::Stopped {
                     condition: c.describe(),
@@ -370,6 +408,39 @@ fn drive<M: Stepper>(
                 diagnosis: diagnose(&what, t1, stepper.y(), scenario),
             });
             break;
+        }
+        if let Some((which, what)) = drift_excess(&limits, &drift, &warned, t1) {
+            let message = drift_message(&what, t1, stepper.y(), scenario);
+            match limits.on_drift {
+                OnDrift::Stop => {
+                    status = Some(Status::Failed { diagnosis: message });
+                    break;
+                }
+                OnDrift::Warn => {
+                    warned[which] = true;
+                    let w = Warning { t: t1, message };
+                    sink.warning(&w)?;
+                    warnings.push(w);
+                }
+            }
+        }
+        let steps = stepper.stats().steps;
+        if steps >= window.0 + COLLAPSE_WINDOW {
+            let h_avg = (t1 - window.1) / (steps - window.0) as f64;
+            let to_go = (t_end - t1) / h_avg;
+            if to_go > MAX_STEPS_TO_GO {
+                let what = format!(
+                    "the step size collapsed: the last {} steps averaged h = {h_avg:.3e} s, so \
+                     reaching t = {t_end} s would take {to_go:.1e} more steps (limit \
+                     {MAX_STEPS_TO_GO:e})",
+                    steps - window.0
+                );
+                status = Some(Status::Failed {
+                    diagnosis: diagnose(&what, t1, stepper.y(), scenario),
+                });
+                break;
+            }
+            window = (steps, t1);
         }
         // The full observation (angles) only when events need it.
         let o1 = if conditions.is_empty() {
@@ -448,7 +519,7 @@ fn drive<M: Stepper>(
                 terminal,
             };
             sink.event(&e, &o)?;
-            events.push(e);
+            keep_event(&mut events, &mut events_not_kept, e);
             if terminal {
                 if te > last_sample_t {
                     sink.sample(&o, &buf, &inv)?;
@@ -500,6 +571,8 @@ fn drive<M: Stepper>(
         stats: stepper.stats(),
         drift,
         events,
+        events_not_kept,
+        warnings,
         samples,
         wall_time: started.elapsed().as_secs_f64(),
     })
@@ -623,5 +696,71 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suspected cause: {cause}; \
          suggested remedy: {remedy}",
         state.join(", ")
+    )
+}
+
+fn keep_event(events: &mut Vec<EventRecord>, not_kept: &mut u64, e: EventRecord) {
+    if events.len() < MAX_EVENTS_KEPT {
+        events.push(e);
+    } else {
+        *not_kept += 1;
+    }
+}
+
+/// The first invariant (index, description) beyond its bound and not yet warned about.
+fn drift_excess(
+    limits: &DriftLimits,
+    drift: &Drift,
+    warned: &[bool; 3],
+    t: f64,
+) -> Option<(usize, String)> {
+    let momentum = drift.h_norm_rel.max(drift.h_inertial_rel);
+    let checks = [
+        (limits.momentum, momentum, "angular momentum (relative)"),
+        (limits.energy, drift.energy_rel, "energy balance (relative)"),
+        (
+            limits.quaternion_norm,
+            drift.q_norm,
+            "quaternion norm ||q| − 1|",
+        ),
+    ];
+    checks
+        .iter()
+        .enumerate()
+        .find_map(|(i, (bound, value, name))| match bound {
+            Some(b) if !warned[i] && *value > *b => Some((
+                i,
+                format!(
+                    "the {name} drifted by {value:.3e} by t = {t} s, beyond the bound {b:e} \
+                     (checks.max_drift)"
+                ),
+            )),
+            _ => None,
+        })
+}
+
+/// Time, state and what to do about drift beyond a bound.
+fn drift_message(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
+    let m = &scenario.method;
+    let remedy = match (m.fixed_step(), m.adaptive()) {
+        (Some(dt), _) => format!(
+            "a smaller step (dt is {dt:e} s; the drift of an order-p method shrinks as dt^p), \
+             or method gauss, which keeps quadratic invariants such as |H|, T and |q| to \
+             round-off for a rigid body"
+        ),
+        (None, Some(a)) => format!(
+            "tighter tolerances (rtol {:e}, atol {:e} now; drift scales roughly with rtol), or \
+             a looser bound if this accuracy is enough",
+            a.rtol, a.atol
+        ),
+        _ => "a looser bound if this accuracy is enough".into(),
+    };
+    format!(
+        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        y.iter()
+            .take(7)
+            .map(|v| format!("{v:.6e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     )
 }
