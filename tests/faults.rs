@@ -705,3 +705,53 @@ fn a_log_over_the_size_limit_is_refused_before_the_run() {
         },
     );
 }
+
+#[test]
+fn devices_are_neither_overwritten_nor_read_forever() {
+    // An output path that is a device would be replaced by the rename that finishes a file.
+    let out = polhode()
+        .args([
+            "run",
+            "scenarios/minor-axis-spin.yaml",
+            "-q",
+            "--out",
+            "/dev/null",
+        ])
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("not a regular file"), "{err}");
+    use std::os::unix::fs::FileTypeExt;
+    assert!(
+        std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device()
+    );
+    record(
+        "faults",
+        "output path is a device",
+        "`polhode run ... --out /dev/null`",
+        &Observed {
+            code: out.status.code(),
+            message: err.trim().to_string(),
+            left: vec!["/dev/null untouched".into()],
+        },
+    );
+    // A scenario that never ends (a device reports no size) is read only up to the limit.
+    let out = polhode().args(["check", "/dev/zero"]).output().unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("longer than 1048576 bytes"), "{err}");
+    record(
+        "faults",
+        "endless scenario input",
+        "`polhode check /dev/zero`",
+        &Observed {
+            code: out.status.code(),
+            message: err.trim().to_string(),
+            left: vec![],
+        },
+    );
+}

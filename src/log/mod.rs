@@ -236,6 +236,7 @@ impl<'a> McapLogger<'a> {
                 path.display()
             )));
         }
+        check_replaceable(path)?;
         std::fs::create_dir_all(&dir)?;
         let file_name = path
             .file_name()
@@ -786,6 +787,7 @@ impl Sink for McapLogger<'_> {
 
 /// Writes `bytes` to `path` through a temporary file and a rename.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    check_replaceable(path)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -805,6 +807,22 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result.map_err(with_hint)
+}
+
+/// Refuses to replace anything but a regular file: outputs are renamed into place, which
+/// would swap a device (`/dev/null`, `/dev/full`), FIFO or socket for a plain file.
+pub fn check_replaceable(path: &Path) -> io::Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} exists and is not a regular file (a directory, device, FIFO or socket); \
+                 outputs replace files by renaming, so give a file path",
+                path.display()
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Adds what to do to an out-of-space error (disk full, quota, file-size limit), keeping its

@@ -39,6 +39,8 @@ pub const MIN_DURATION: f64 = 1e-9;
 /// Default largest log (MB): a run whose log is estimated to be larger is refused before it
 /// starts (`output.max_log_mb`, `--max-log-mb`).
 pub const DEFAULT_MAX_LOG_MB: f64 = 2000.0;
+/// Largest relative tolerance: beyond it an adaptive method's error control means nothing.
+pub const MAX_RTOL: f64 = 0.1;
 /// Smallest absolute tolerance: below it the scaled error norm overflows for components
 /// near zero, and the error test (and radau5's Newton test) can never pass.
 pub const MIN_ATOL: f64 = 1e-30;
@@ -622,8 +624,22 @@ pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioErro
             ),
         ));
     }
-    let bytes = std::fs::read(path)
+    // Read at most one byte past the limit: a FIFO or a device (`/dev/zero`) reports no size.
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| {
+            use std::io::Read;
+            f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes)
+        })
         .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(ScenarioError::whole_file(
+            path,
+            format!(
+                "the input is longer than {MAX_FILE_BYTES} bytes, the largest scenario accepted"
+            ),
+        ));
+    }
     if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
         return Err(ScenarioError::at(
             path,
@@ -1398,6 +1414,25 @@ impl ScenarioFile {
                 l,
                 f,
                 format!("rtol {rtol:e} is below double precision; use at least 1e-15"),
+            ));
+        }
+        if let Some(Adaptive { rtol, .. }) = method.adaptive()
+            && rtol > MAX_RTOL
+        {
+            let (l, f) = from(
+                ov.rtol,
+                spec.rtol.as_ref().and_then(loc),
+                "integrator.rtol",
+                "--rtol",
+            );
+            return Err(err(
+                l,
+                f,
+                format!(
+                    "rtol {} would allow errors of {:.0} % per step; use at most {MAX_RTOL}",
+                    number(rtol),
+                    100.0 * rtol
+                ),
             ));
         }
 
