@@ -755,3 +755,43 @@ fn devices_are_neither_overwritten_nor_read_forever() {
         },
     );
 }
+
+#[test]
+fn campaign_text_that_reads_as_a_number_is_refused() {
+    // Found by fuzzing: runs are built from the YAML tree as JSON values, where `name: 1e2`
+    // becomes 100.0 and `.nan` has no value at all.
+    for name in ["1e2", "0x1F", ".nan"] {
+        let yaml = format!(
+            "name: {name}\nbody: {{principal: [1.0, 2.0, 3.0]}}\ninitial: {{omega: [0.1, 0, 0]}}\n\
+             duration: 1.0\nmontecarlo:\n  runs: 2\n"
+        );
+        let dir = scratch(&format!("numeric-name-{}", name.replace('.', "")));
+        std::fs::write(dir.join("s.yaml"), &yaml).unwrap();
+        let out = polhode()
+            .args(["montecarlo", "s.yaml", "-q", "--out", "c"])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains("quote it"), "{name}: {err}");
+        assert_eq!(names(&dir), vec!["s.yaml".to_string()], "{name}");
+        // Quoted, it runs.
+        std::fs::write(
+            dir.join("s.yaml"),
+            yaml.replace(&format!("name: {name}"), &format!("name: \"{name}\"")),
+        )
+        .unwrap();
+        let out = polhode()
+            .args(["montecarlo", "s.yaml", "-q", "--out", "c"])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{name} quoted: {}",
+            stderr(&out)
+        );
+    }
+}

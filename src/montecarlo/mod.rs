@@ -98,11 +98,42 @@ impl Prepared {
                  docs/montecarlo.md)",
             ));
         };
+        // Runs are built from the scenario's YAML tree. The tree holds JSON values, so text
+        // that reads as a number (`name: 1e2`, `name: .nan`) would come back as another text
+        // or not at all: such values must be quoted.
+        const QUOTE: &str = "a text value in this scenario reads as a number (e.g. `name: 1e2`, \
+                             `name: 0x1F`, `name: .nan`); quote it (`name: \"1e2\"`) to run a \
+                             campaign";
         let mut tree: Value = serde_saphyr::from_str(&scenario.source).map_err(|e| {
-            ScenarioError::whole_file(&path, format!("cannot read the YAML as a tree: {e}"))
+            let first = e.without_snippet().to_string();
+            let first = first.lines().next().unwrap_or("").to_string();
+            let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+            ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
         })?;
         if let Some(map) = tree.as_object_mut() {
             map.remove("montecarlo");
+        }
+        let text = serde_json::to_string(&tree).unwrap_or_default();
+        let same = match scenario::parse(&path, text, &Overrides::default()) {
+            Ok(back) => {
+                let names = |s: &Scenario| -> Vec<String> {
+                    s.spacecraft
+                        .effectors()
+                        .iter()
+                        .map(|e| e.name().to_string())
+                        .collect()
+                };
+                back.name == scenario.name
+                    && back.description == scenario.description
+                    && back.mcap_path == scenario.mcap_path
+                    && back.epoch_unix_ns == scenario.epoch_unix_ns
+                    && back.method.describe() == scenario.method.describe()
+                    && names(&back) == names(&scenario)
+            }
+            Err(_) => false,
+        };
+        if !same {
+            return Err(ScenarioError::whole_file(&path, QUOTE));
         }
         let mut campaign = Campaign::new(&path, file, &tree, scenario.duration)?;
         if let Some(r) = runs {
