@@ -67,7 +67,7 @@ impl std::error::Error for ScenarioError {}
 pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
     // (indent, key, index of the sequence item under the key, if it holds a sequence)
     let mut stack: Vec<(usize, String, Option<usize>)> = Vec::new();
-    for (index, raw) in source.lines().enumerate() {
+    for (index, raw) in yaml_lines(source).into_iter().enumerate() {
         let number = index as u32 + 1;
         if number > line {
             break;
@@ -137,6 +137,36 @@ pub fn field_path_at(source: &str, line: u32, column: u32) -> String {
         .join(".")
 }
 
+/// The lines of `source` as YAML counts them: a line ends at LF, CRLF or a lone CR (which
+/// `str::lines` does not split at), so that line numbers agree with the parser's.
+pub fn yaml_lines(source: &str) -> Vec<&str> {
+    let bytes = source.as_bytes();
+    let mut lines = Vec::new();
+    let mut start = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'\n' => {
+                lines.push(&source[start..i]);
+                start = i + 1;
+            }
+            b'\r' => {
+                lines.push(&source[start..i]);
+                if bytes.get(i + 1) == Some(&b'\n') {
+                    i += 1;
+                }
+                start = i + 1;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    if start < bytes.len() {
+        lines.push(&source[start..]);
+    }
+    lines
+}
+
 fn block_key(s: &str) -> Option<&str> {
     let (key, _) = s.split_once(':')?;
     let key = key.trim().trim_matches(|c| c == '"' || c == '\'');
@@ -196,6 +226,14 @@ mod tests {
         assert_eq!(field_path_at(y, 6, 7), "effectors[1].beam.EI");
         // A sequence at the key's own indent.
         assert_eq!(field_path_at(y, 9, 3), "next[1].b");
+    }
+
+    #[test]
+    fn lines_end_at_lf_crlf_and_lone_cr() {
+        assert_eq!(yaml_lines("a\nb\r\nc\rd"), ["a", "b", "c", "d"]);
+        assert_eq!(yaml_lines("a\n"), ["a"]);
+        // The field is found on the line the parser names.
+        assert_eq!(field_path_at("x: 1\r\rbody:\r  mass: 2\r", 4, 3), "body.mass");
     }
 
     #[test]

@@ -820,8 +820,8 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
 /// reported later than their cause (YAML flow lists and quoted text may span lines).
 fn unclosed_before(source: &str, line: u32) -> Option<String> {
     let mut open: Vec<(char, u32)> = Vec::new();
-    for (i, raw) in source
-        .lines()
+    for (i, raw) in error::yaml_lines(source)
+        .into_iter()
         .enumerate()
         .take(line.saturating_sub(1) as usize)
     {
@@ -856,7 +856,7 @@ fn unclosed_before(source: &str, line: u32) -> Option<String> {
 /// The scalar text starting at (`line`, `column`), 1-based, up to a flow indicator, comment or
 /// the end of the line; `None` when empty or not a plain scalar.
 fn scalar_at(source: &str, line: u32, column: u32) -> Option<String> {
-    let text = source.lines().nth(line.checked_sub(1)? as usize)?;
+    let text = *error::yaml_lines(source).get(line.checked_sub(1)? as usize)?;
     let rest: String = text
         .chars()
         .skip(column.checked_sub(1)? as usize)
@@ -966,8 +966,8 @@ fn drift_limits(
 
 /// Where the top-level `key:` is written (line, column), for errors about what it lacks.
 fn key_location(source: &str, key: &str) -> Option<(u32, u32)> {
-    source
-        .lines()
+    error::yaml_lines(source)
+        .into_iter()
         .position(|l| {
             l.strip_prefix(key)
                 .is_some_and(|r| r.trim_start().starts_with(':'))
