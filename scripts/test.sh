@@ -24,3 +24,7 @@ RUNS=200 SHARDS=4 SEED=3 scripts/slurm/test-local.sh tests/data/montecarlo-sink.
 viewer_out=$(mktemp -d)
 scripts/viewers/screenshots.sh "$viewer_out"
 rm -rf "$viewer_out"
+# Fuzzing for a bounded time (docs/reliability.md): the scenario loader and the MCAP/summary
+# writers, 30 s each side by side (installs cargo-fuzz if missing; `scripts/fuzz.sh 3600` for
+# longer runs on demand).
+scripts/fuzz.sh 30
