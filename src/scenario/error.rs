@@ -233,7 +233,10 @@ mod tests {
         assert_eq!(yaml_lines("a\nb\r\nc\rd"), ["a", "b", "c", "d"]);
         assert_eq!(yaml_lines("a\n"), ["a"]);
         // The field is found on the line the parser names.
-        assert_eq!(field_path_at("x: 1\r\rbody:\r  mass: 2\r", 4, 3), "body.mass");
+        assert_eq!(
+            field_path_at("x: 1\r\rbody:\r  mass: 2\r", 4, 3),
+            "body.mass"
+        );
     }
 
     #[test]

@@ -287,13 +287,14 @@ pub const DIVERGENCE_ENERGY_REL: f64 = 0.5;
 /// event that fires every period of a very long run cannot use unbounded memory.
 pub const MAX_EVENTS_KEPT: usize = 10_000;
 
-/// A run whose step size has collapsed so far that finishing would take more than this many
-/// steps stops as failed (the same bound the scenario checks put on the work a file may ask
-/// for): a singularity of the model, or stiffness an explicit method crawls through.
+/// A run whose average step, over two consecutive windows of [`COLLAPSE_WINDOW`] steps, is
+/// so small that its whole duration would take more than this many steps stops as failed
+/// (the bound the scenario checks put on the work a file may ask for): a singularity of the
+/// model, or stiffness an explicit method crawls through.
 pub const MAX_STEPS_TO_GO: f64 = 1e11;
 
 /// Steps over which the average step size is measured for [`MAX_STEPS_TO_GO`].
-const COLLAPSE_WINDOW: u64 = 100_000;
+const COLLAPSE_WINDOW: u64 = 10_000;
 
 /// How often (in steps) the interrupt flag and the wall clock are looked at.
 const POLL_STEPS: u64 = 64;
@@ -322,6 +323,7 @@ fn drive<M: Stepper>(
     let mut warned = [false; 3];
     let limits = scenario.drift_limits;
     let mut window = (0u64, 0.0f64);
+    let mut collapsed_windows = 0u32;
     let conditions: Vec<(&Condition, bool)> = scenario
         .stop
         .iter()
@@ -427,13 +429,18 @@ fn drive<M: Stepper>(
         let steps = stepper.stats().steps;
         if steps >= window.0 + COLLAPSE_WINDOW {
             let h_avg = (t1 - window.1) / (steps - window.0) as f64;
-            let to_go = (t_end - t1) / h_avg;
-            if to_go > MAX_STEPS_TO_GO {
+            let whole = t_end / h_avg;
+            collapsed_windows = if whole > MAX_STEPS_TO_GO {
+                collapsed_windows + 1
+            } else {
+                0
+            };
+            if collapsed_windows >= 2 {
                 let what = format!(
-                    "the step size collapsed: the last {} steps averaged h = {h_avg:.3e} s, so \
-                     reaching t = {t_end} s would take {to_go:.1e} more steps (limit \
+                    "the step size collapsed: the last {} steps averaged h = {h_avg:.3e} s, a \
+                     step at which the {t_end} s run would take {whole:.1e} steps (limit \
                      {MAX_STEPS_TO_GO:e})",
-                    steps - window.0
+                    COLLAPSE_WINDOW
                 );
                 status = Some(Status::Failed {
                     diagnosis: diagnose(&what, t1, stepper.y(), scenario),
@@ -651,6 +658,13 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         .then(|| crate::linearize::stiffness(sc, t, y, scenario.duration));
     let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
     let m = &scenario.method;
+    if let Some((cause, remedy)) = hinge_singularity(sc, y) {
+        return format!(
+            "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suspected cause: \
+             {cause}; suggested remedy: {remedy}",
+            state.join(", ")
+        );
+    }
     let (cause, remedy) = match (m.fixed_step(), stability_bound(m)) {
         (Some(h), Some(bound)) if rho.is_finite() && h * rho > 0.8 * bound => (
             format!(
@@ -763,4 +777,36 @@ fn drift_message(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     )
+}
+
+/// A hinged rod with both flap and lag near flap = ±90°: there the rod lies along the lag
+/// axis, the flap–lag coordinates are singular (lag is undefined), and a lag spring or damper
+/// acting on a vanishing inertia makes the equations infinitely stiff. No integrator gets past
+/// it, so the diagnosis names it rather than blaming generic stiffness.
+fn hinge_singularity(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
+    for (k, e) in sc.effectors().iter().enumerate() {
+        let names = e.state_names();
+        if e.kind() != "hinged_rod" || names.first().map(String::as_str) != Some("flap") {
+            continue;
+        }
+        if names.get(1).map(String::as_str) != Some("lag") {
+            continue;
+        }
+        let flap = sc.effector_states(k, y)[0];
+        if flap.cos().abs() < 0.05 {
+            return Some((
+                format!(
+                    "the hinged rod `{}` has swung to flap = {:.2}°: at ±90° it lies along its \
+                     lag axis, where the flap–lag angles are singular (lag is undefined) and \
+                     the lag spring and damper act on no inertia",
+                    e.name(),
+                    flap.to_degrees()
+                ),
+                "keep the rod away from 90° flap (a stiffer flap spring, a smaller initial \
+                 flap rate), or give it one freedom (`freedom: flap` or `lag`)"
+                    .into(),
+            ));
+        }
+    }
+    None
 }
