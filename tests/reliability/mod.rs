@@ -21,7 +21,7 @@ pub fn scratch(name: &str) -> PathBuf {
 
 /// What a case did, as observed.
 pub struct Observed {
-    /// Exit code (`None`: killed by a signal).
+    /// Exit code (`None`: no process, a library-level case).
     pub code: Option<i32>,
     /// The message the user saw (stderr, or its relevant line).
     pub message: String,
@@ -38,7 +38,7 @@ pub fn record(table: &str, case: &str, what: &str, seen: &Observed) {
     let dir = PathBuf::from(dir);
     std::fs::create_dir_all(&dir).unwrap();
     let clean = |s: &str| s.replace(['\t', '\n'], " ");
-    let code = seen.code.map_or("signal".to_string(), |c| c.to_string());
+    let code = seen.code.map_or("—".to_string(), |c| c.to_string());
     let left = if seen.left.is_empty() {
         "nothing".to_string()
     } else {
