@@ -478,25 +478,7 @@ impl<'a> McapLogger<'a> {
         y0[3..7].copy_from_slice(&[0.5; 4]);
         let o = sc.observe(0.0, &y0);
         let inv = Reference::of(&o);
-        let q = o.attitude;
-        let tf = fg::FrameTransforms {
-            transforms: vec![fg::FrameTransform {
-                timestamp: Some(self.timestamp(0.0)),
-                parent_frame_id: WORLD_FRAME.into(),
-                child_frame_id: self.body_frame.clone(),
-                translation: Some(fg::Vector3 {
-                    x: 0.0,
-                    y: 0.0,
-                    z: 0.0,
-                }),
-                rotation: Some(fg::Quaternion {
-                    x: q.i,
-                    y: q.j,
-                    z: q.k,
-                    w: q.w,
-                }),
-            }],
-        };
+        let tf = self.body_transform(&o);
         let mut per_sample = self.encoded_len(&tf) + PER_MESSAGE;
         telemetry::encode_doubles(&telemetry::values(&o, &inv), &mut self.buf);
         per_sample += self.buf.len() as f64 + PER_MESSAGE;
@@ -520,6 +502,29 @@ impl<'a> McapLogger<'a> {
         // Scene updates grow as appendages deflect: uncompressed logs of the shipped scenarios
         // measured 0.76–1.05 times the raw figure (docs/reliability.md); 10 % covers that.
         1.1 * (samples * per_sample + scenes * per_scene) + fixed
+    }
+
+    /// The `/tf` message placing the body frame in `world` at the observation's attitude.
+    fn body_transform(&self, o: &Observation) -> fg::FrameTransforms {
+        let q = o.attitude;
+        fg::FrameTransforms {
+            transforms: vec![fg::FrameTransform {
+                timestamp: Some(self.timestamp(o.t)),
+                parent_frame_id: WORLD_FRAME.into(),
+                child_frame_id: self.body_frame.clone(),
+                translation: Some(fg::Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                }),
+                rotation: Some(fg::Quaternion {
+                    x: q.i,
+                    y: q.j,
+                    z: q.k,
+                    w: q.w,
+                }),
+            }],
+        }
     }
 
     fn encoded_len<T: Encode>(&mut self, msg: &T) -> f64 {
@@ -716,25 +721,7 @@ impl<'a> McapLogger<'a> {
 
 impl Sink for McapLogger<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> io::Result<()> {
-        let q = o.attitude;
-        let tf = fg::FrameTransforms {
-            transforms: vec![fg::FrameTransform {
-                timestamp: Some(self.timestamp(o.t)),
-                parent_frame_id: WORLD_FRAME.into(),
-                child_frame_id: self.body_frame.clone(),
-                translation: Some(fg::Vector3 {
-                    x: 0.0,
-                    y: 0.0,
-                    z: 0.0,
-                }),
-                rotation: Some(fg::Quaternion {
-                    x: q.i,
-                    y: q.j,
-                    z: q.k,
-                    w: q.w,
-                }),
-            }],
-        };
+        let tf = self.body_transform(o);
         self.write(self.channels.tf, o.t, &tf)?;
         // Allow for rounding of the sample grid so that a 10 Hz scene is not skipped at 100 Hz.
         let due = self

@@ -649,7 +649,7 @@ fn stability_bound(m: &Method) -> Option<f64> {
 /// A diagnosis for a failed integration: what, when, the state, the suspected cause and what
 /// to try.
 pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
-    let state: Vec<String> = y.iter().take(7).map(|v| format!("{v:.6e}")).collect();
+    let state = hub_state_text(y);
     // `t` and `y` are the last finite state known: how stiff are the equations there?
     let sc = &scenario.spacecraft;
     let stiffness = y
@@ -658,58 +658,54 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         .then(|| crate::linearize::stiffness(sc, t, y, scenario.duration));
     let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
     let m = &scenario.method;
-    if let Some((cause, remedy)) = hinge_singularity(sc, y) {
-        return format!(
-            "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suspected cause: \
-             {cause}; suggested remedy: {remedy}",
-            state.join(", ")
-        );
-    }
-    let (cause, remedy) = match (m.fixed_step(), stability_bound(m)) {
-        (Some(h), Some(bound)) if rho.is_finite() && h * rho > 0.8 * bound => (
-            format!(
-                "numerical instability: the fastest eigenvalue of the equations has \
+    let (cause, remedy) = if let Some(found) = hinge_singularity(sc, y) {
+        found
+    } else {
+        match (m.fixed_step(), stability_bound(m)) {
+            (Some(h), Some(bound)) if rho.is_finite() && h * rho > 0.8 * bound => (
+                format!(
+                    "numerical instability: the fastest eigenvalue of the equations has \
                  |λ| = {rho:.4e} 1/s, so h·|λ| = {:.3} is beyond {}'s stability bound ≈ \
                  {bound:.2} (largest stable step ≈ {:.3e} s)",
-                h * rho,
-                m.name(),
-                bound / rho
-            ),
-            format!(
-                "reduce dt below {:.3e} s, or use an implicit method: radau5 (adaptive) or \
+                    h * rho,
+                    m.name(),
+                    bound / rho
+                ),
+                format!(
+                    "reduce dt below {:.3e} s, or use an implicit method: radau5 (adaptive) or \
                  gauss (fixed step, A-stable)",
-                0.8 * bound / rho
+                    0.8 * bound / rho
+                ),
             ),
-        ),
-        (Some(h), _) => (
-            format!(
-                "the fixed step dt = {h:e} s is too coarse for this scene (fastest |λ| = \
+            (Some(h), _) => (
+                format!(
+                    "the fixed step dt = {h:e} s is too coarse for this scene (fastest |λ| = \
                  {rho:.4e} 1/s)"
+                ),
+                "reduce dt, or use an adaptive method (dop853, or radau5 when stiff)".into(),
             ),
-            "reduce dt, or use an adaptive method (dop853, or radau5 when stiff)".into(),
-        ),
-        (None, _) if matches!(m, Method::Exact) => (
-            "the closed-form solution failed".into(),
-            "report this as a bug with the scenario attached".into(),
-        ),
-        (None, _) if !m.is_implicit() && stiffness.is_some_and(|s| s.ratio() > 1e3) => (
-            format!(
-                "stiffness: the fastest eigenvalue |λ| = {rho:.4e} 1/s is {:.1e} times the \
+            (None, _) if matches!(m, Method::Exact) => (
+                "the closed-form solution failed".into(),
+                "report this as a bug with the scenario attached".into(),
+            ),
+            (None, _) if !m.is_implicit() && stiffness.is_some_and(|s| s.ratio() > 1e3) => (
+                format!(
+                    "stiffness: the fastest eigenvalue |λ| = {rho:.4e} 1/s is {:.1e} times the \
                  motion's rate, so an explicit method crawls at its stability limit",
-                stiffness.map_or(f64::NAN, |s| s.ratio())
+                    stiffness.map_or(f64::NAN, |s| s.ratio())
+                ),
+                "use radau5 (or auto, which picks it for stiff scenes)".into(),
             ),
-            "use radau5 (or auto, which picks it for stiff scenes)".into(),
-        ),
-        (None, _) => (
-            "a singularity of the model, or a tolerance that cannot be met".into(),
-            "check the model parameters (e.g. a vanishing inertia or mass); loosen rtol/atol"
-                .into(),
-        ),
+            (None, _) => (
+                "a singularity of the model, or a tolerance that cannot be met".into(),
+                "check the model parameters (e.g. a vanishing inertia or mass); loosen rtol/atol"
+                    .into(),
+            ),
+        }
     };
     format!(
-        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suspected cause: {cause}; \
-         suggested remedy: {remedy}",
-        state.join(", ")
+        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{state}]; suspected cause: \
+         {cause}; suggested remedy: {remedy}"
     )
 }
 
@@ -771,11 +767,7 @@ fn drift_message(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
     };
     format!(
         "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
-        y.iter()
-            .take(7)
-            .map(|v| format!("{v:.6e}"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        hub_state_text(y)
     )
 }
 
@@ -809,4 +801,13 @@ fn hinge_singularity(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
         }
     }
     None
+}
+
+/// The hub's rates and attitude (the first seven states) for diagnoses.
+fn hub_state_text(y: &[f64]) -> String {
+    y.iter()
+        .take(7)
+        .map(|v| format!("{v:.6e}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
