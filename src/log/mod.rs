@@ -3,10 +3,14 @@
 //! Topics: `/tf` (`foxglove.FrameTransforms`, world → body), `/scene` (`foxglove.SceneUpdate`,
 //! the body and arrows for ω and H, frame-locked to `body`), `/telemetry` (`polhode.Telemetry`)
 //! and `/log` (`foxglove.Log`, events and the run's end). All protobuf, schemas embedded.
+//! `/effectors/<name>` channels share one schema per effector kind and field set
+//! (`polhode.effectors.HingedRodFlapLag`, [`units::effector_message`]); every field of the
+//! polhode schemas carries its unit as its protobuf comment ([`units::field_unit`]).
 //! Log time = scenario epoch + sim time. The file is written under a temporary name in the
 //! target directory and renamed when finished, so a final name never holds a half-written log.
 
 pub mod telemetry;
+pub mod units;
 
 use crate::model::{Drawing, HubState, Observation, Spacecraft};
 use crate::scenario::{Compression, Scenario, Shape, format_epoch};
@@ -51,7 +55,19 @@ pub struct McapLogger<'a> {
     scene: SceneStyle,
     /// Name of the body frame (`body`, or `<prefix>/body` when runs share a file).
     body_frame: String,
+    /// The polhode schemas and channels registered so far.
+    registry: Registry,
     buf: Vec<u8>,
+}
+
+/// What [`register`] has added to a file, across the runs that share it.
+#[derive(Default)]
+struct Registry {
+    /// Fields of each effector schema (by message name) already in the file.
+    effector_schemas: BTreeMap<String, Vec<String>>,
+    /// Bytes of the polhode schemas and of the channel topics and metadata (each is written
+    /// twice: in the data section and in the summary).
+    bytes: usize,
 }
 
 struct Channels {
@@ -131,6 +147,7 @@ fn body_frame(prefix: &str) -> String {
 /// Adds the schemas and channels of one run under `prefix`.
 fn register(
     writer: &mut mcap::Writer<BufWriter<File>>,
+    registry: &mut Registry,
     scenario: &Scenario,
     prefix: &str,
 ) -> io::Result<(Channels, Vec<u16>)> {
@@ -141,34 +158,45 @@ fn register(
     let tid = writer
         .add_schema(telemetry::SCHEMA_NAME, "protobuf", &schema)
         .map_err(io_err)?;
-    let telemetry = writer
-        .add_channel(
-            tid,
-            &format!("{prefix}/telemetry"),
-            "protobuf",
-            &BTreeMap::new(),
-        )
-        .map_err(io_err)?;
+    let telemetry = add_channel(
+        writer,
+        registry,
+        tid,
+        format!("{prefix}/telemetry"),
+        BTreeMap::from([(
+            "units".to_string(),
+            telemetry::units_metadata(units::TELEMETRY, &telemetry::FIELDS),
+        )]),
+    )?;
     let log = add::<fg::Log>(writer, &format!("{prefix}/log"))?;
     let mut effector_channels = Vec::new();
     for e in scenario.spacecraft.effectors() {
         let mut names = vec!["sim_time".to_string()];
         names.extend(e.telemetry_names());
-        let message = message_name(e.name());
-        let schema = telemetry::schema_for("polhode.effectors", &message, &names);
+        let message = effector_schema_name(registry, e.kind(), &names);
+        let schema = telemetry::schema_for("polhode.effectors", &message, e.kind(), &names);
+        let name = format!("polhode.effectors.{message}");
+        if !registry.effector_schemas.contains_key(&message) {
+            registry.bytes += name.len() + schema.len();
+            registry.effector_schemas.insert(message, names.clone());
+        }
+        // Identical schemas (same name and fields) are written once and shared.
         let id = writer
-            .add_schema(&format!("polhode.effectors.{message}"), "protobuf", &schema)
+            .add_schema(&name, "protobuf", &schema)
             .map_err(io_err)?;
-        effector_channels.push(
-            writer
-                .add_channel(
-                    id,
-                    &format!("{prefix}/effectors/{}", e.name()),
-                    "protobuf",
-                    &BTreeMap::from([("kind".to_string(), e.kind().to_string())]),
-                )
-                .map_err(io_err)?,
-        );
+        effector_channels.push(add_channel(
+            writer,
+            registry,
+            id,
+            format!("{prefix}/effectors/{}", e.name()),
+            BTreeMap::from([
+                ("kind".to_string(), e.kind().to_string()),
+                (
+                    "units".to_string(),
+                    telemetry::units_metadata(e.kind(), &names),
+                ),
+            ]),
+        )?);
     }
     Ok((
         Channels {
@@ -179,6 +207,43 @@ fn register(
         },
         effector_channels,
     ))
+}
+
+/// Adds a protobuf channel, counting its topic and metadata in `registry`.
+fn add_channel(
+    writer: &mut mcap::Writer<BufWriter<File>>,
+    registry: &mut Registry,
+    schema: u16,
+    topic: String,
+    metadata: BTreeMap<String, String>,
+) -> io::Result<u16> {
+    registry.bytes += topic.len()
+        + metadata
+            .iter()
+            .map(|(k, v)| k.len() + v.len())
+            .sum::<usize>();
+    writer
+        .add_channel(schema, &topic, "protobuf", &metadata)
+        .map_err(io_err)
+}
+
+/// The message name of the schema for an effector of `kind` with `fields`: that of
+/// [`units::effector_message`], unless the file already has a schema of that name with other
+/// fields (a kind whose variants the name does not tell apart); then the name followed by `_`
+/// and a hash of the field names, so that a name never stands for two field sets.
+fn effector_schema_name(registry: &Registry, kind: &str, fields: &[String]) -> String {
+    let message = units::effector_message(kind, fields);
+    match registry.effector_schemas.get(&message) {
+        Some(known) if known.as_slice() != fields => {
+            // FNV-1a over the names, each followed by a 0 byte.
+            let mut h: u32 = 0x811c_9dc5;
+            for b in fields.iter().flat_map(|f| f.bytes().chain([0])) {
+                h = (h ^ u32::from(b)).wrapping_mul(0x0100_0193);
+            }
+            format!("{message}_{h:08x}")
+        }
+        _ => message,
+    }
 }
 
 fn io_err(e: mcap::McapError) -> io::Error {
@@ -196,18 +261,6 @@ fn add<T: Encode>(w: &mut mcap::Writer<BufWriter<File>>, topic: &str) -> io::Res
         .map_err(io_err)?;
     w.add_channel(id, topic, &T::get_message_encoding(), &BTreeMap::new())
         .map_err(io_err)
-}
-
-/// The protobuf message name for an effector's telemetry: its name made an identifier.
-fn message_name(effector: &str) -> String {
-    let mut m: String = effector
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-        .collect();
-    if !m.starts_with(|c: char| c.is_ascii_alphabetic()) {
-        m.insert(0, 'E');
-    }
-    m
 }
 
 impl<'a> McapLogger<'a> {
@@ -259,7 +312,8 @@ impl<'a> McapLogger<'a> {
         let mut writer = options
             .create(BufWriter::with_capacity(1 << 16, file))
             .map_err(io_err)?;
-        let (channels, effector_channels) = register(&mut writer, scenario, prefix)?;
+        let mut registry = Registry::default();
+        let (channels, effector_channels) = register(&mut writer, &mut registry, scenario, prefix)?;
         Ok(McapLogger {
             spacecraft: &scenario.spacecraft,
             effector_channels,
@@ -271,6 +325,7 @@ impl<'a> McapLogger<'a> {
             sequence: 0,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
             body_frame: body_frame(prefix),
+            registry,
             buf: Vec::with_capacity(1024),
         })
     }
@@ -288,10 +343,11 @@ impl<'a> McapLogger<'a> {
             temp,
             final_path,
             sequence,
+            mut registry,
             buf,
             ..
         } = self;
-        let (channels, effector_channels) = register(&mut writer, scenario, prefix)?;
+        let (channels, effector_channels) = register(&mut writer, &mut registry, scenario, prefix)?;
         Ok(McapLogger {
             spacecraft: &scenario.spacecraft,
             effector_channels,
@@ -303,6 +359,7 @@ impl<'a> McapLogger<'a> {
             sequence,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
             body_frame: body_frame(prefix),
+            registry,
             buf,
         })
     }
@@ -463,7 +520,8 @@ impl<'a> McapLogger<'a> {
     /// Estimated size of the finished log (bytes, before chunk compression) for `scenario`
     /// run to its end: every message of the first sample encoded as the run will encode it,
     /// times the number of samples and scene updates, plus MCAP's per-message record and index
-    /// (47 bytes) and the summary, schemas and attachments, with a 10 % margin. Compression
+    /// (47 bytes) and the summary, schemas (polhode's own, with their field comments, counted
+    /// as registered: each written twice) and attachments, with a 10 % margin. Compression
     /// only makes the file smaller.
     pub fn estimate_bytes(&mut self, scenario: &Scenario) -> f64 {
         const PER_MESSAGE: f64 = 47.0;
@@ -498,7 +556,8 @@ impl<'a> McapLogger<'a> {
         let samples = (scenario.duration * scenario.output_rate).floor() + 2.0;
         let scenes =
             (scenario.duration * scenario.scene_rate.min(scenario.output_rate)).floor() + 2.0;
-        let fixed = 64.0 * 1024.0 + 2.0 * scenario.source.len() as f64;
+        let fixed =
+            64.0 * 1024.0 + 2.0 * self.registry.bytes as f64 + 2.0 * scenario.source.len() as f64;
         // Scene updates grow as appendages deflect: uncompressed logs of the shipped scenarios
         // measured 0.76–1.05 times the raw figure (docs/reliability.md); 10 % covers that.
         1.1 * (samples * per_sample + scenes * per_scene) + fixed
@@ -825,5 +884,300 @@ pub fn with_hint(e: io::Error) -> io::Error {
         )
     } else {
         e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Overrides;
+    use prost::Message as _;
+    use prost_types::FileDescriptorSet;
+    use std::sync::atomic::AtomicBool;
+
+    fn root() -> PathBuf {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    }
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("polhode-log-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Runs `scenario` (YAML text) for `duration` s into `out`; returns the log's bytes and
+    /// the size estimated before the run.
+    fn run(
+        text: &str,
+        duration: f64,
+        compression: Option<Compression>,
+        out: &Path,
+    ) -> (Vec<u8>, f64) {
+        let overrides = Overrides {
+            duration: Some(duration),
+            mcap: Some(out.to_path_buf()),
+            ..Default::default()
+        };
+        let mut s = crate::scenario::parse(Path::new("test.yaml"), text.to_string(), &overrides)
+            .unwrap_or_else(|e| panic!("{e}"));
+        if let Some(c) = compression {
+            s.compression = c;
+        }
+        let mut logger = McapLogger::create(out, &s, s.omega0.norm()).unwrap();
+        let estimate = logger.estimate_bytes(&s);
+        let stop = AtomicBool::new(false);
+        let ctl = crate::sim::Control {
+            interrupt: &stop,
+            progress: None,
+        };
+        let outcome = crate::sim::run(&s, &mut logger, ctl).unwrap();
+        logger.finish(&s, "test", &outcome).unwrap();
+        (std::fs::read(out).unwrap(), estimate)
+    }
+
+    fn summary(bytes: &[u8]) -> mcap::Summary {
+        mcap::Summary::read(bytes).unwrap().expect("a summary")
+    }
+
+    /// The unit at the end of a field comment: ` <description> (<unit>).`
+    fn unit_of(comment: &str) -> Option<&str> {
+        let c = comment.trim_end().strip_suffix(").")?;
+        let open = c.rfind('(')?;
+        let unit = &c[open + 1..];
+        (open > 0 && !unit.trim().is_empty() && !unit.contains(')')).then_some(unit)
+    }
+
+    /// Every field of every polhode schema in the log has a comment ending in a unit, the
+    /// same unit as the channel's `units` metadata. Returns the number of fields checked.
+    fn check_units(bytes: &[u8], what: &str) -> usize {
+        let summary = summary(bytes);
+        let mut checked = 0;
+        for ch in summary.channels.values() {
+            let schema = ch.schema.as_ref().unwrap();
+            if !schema.name.starts_with("polhode.") {
+                continue;
+            }
+            let set = FileDescriptorSet::decode(&*schema.data).unwrap();
+            assert_eq!(set.file.len(), 1, "{what} {}", ch.topic);
+            let file = &set.file[0];
+            let msg = &file.message_type[0];
+            assert_eq!(
+                format!("{}.{}", file.package(), msg.name()),
+                schema.name,
+                "{what}"
+            );
+            let locations = &file.source_code_info.as_ref().unwrap().location;
+            let units: serde_json::Value =
+                serde_json::from_str(ch.metadata.get("units").expect("units metadata")).unwrap();
+            assert_eq!(units.as_object().unwrap().len(), msg.field.len());
+            for (i, f) in msg.field.iter().enumerate() {
+                let loc = locations
+                    .iter()
+                    .find(|l| l.path == [4, 0, 2, i as i32])
+                    .unwrap_or_else(|| panic!("{what} {}: no comment on {}", ch.topic, f.name()));
+                let comment = loc.leading_comments();
+                let unit = unit_of(comment).unwrap_or_else(|| {
+                    panic!(
+                        "{what} {} ({}): field {} has no unit in its comment {comment:?}",
+                        ch.topic,
+                        schema.name,
+                        f.name()
+                    )
+                });
+                assert_eq!(units[f.name()], unit, "{what} {} {}", ch.topic, f.name());
+                checked += 1;
+            }
+        }
+        checked
+    }
+
+    fn shipped(name: &str) -> String {
+        std::fs::read_to_string(root().join("scenarios").join(name)).unwrap()
+    }
+
+    #[test]
+    fn every_field_of_every_shipped_scenario_has_a_unit() {
+        let dir = scratch("units");
+        let mut names: Vec<String> = std::fs::read_dir(root().join("scenarios"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".yaml"))
+            .collect();
+        names.sort();
+        for must in [
+            "explorer1-pydy.yaml",
+            "explorer1-pydy-modal.yaml",
+            "nutation-damper.yaml",
+            "wheel-damper.yaml",
+            "flexible-boom.yaml",
+            "spin-up.yaml",
+            "tennis-racket.yaml",
+        ] {
+            assert!(names.iter().any(|n| n == must), "{must} is not shipped");
+        }
+        for name in &names {
+            let (bytes, _) = run(&shipped(name), 0.05, None, &dir.join("u.mcap"));
+            // /telemetry, then each effector's fields.
+            assert!(
+                check_units(&bytes, name) >= telemetry::FIELDS.len(),
+                "{name}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn four_rods_share_one_schema() {
+        let dir = scratch("rods");
+        let (bytes, _) = run(
+            &shipped("explorer1-pydy.yaml"),
+            0.05,
+            None,
+            &dir.join("r.mcap"),
+        );
+        let summary = summary(&bytes);
+        // /tf, /scene, /telemetry, /log and /effectors/antenna_1 … _4, as before.
+        assert_eq!(summary.channels.len(), 8);
+        let rods: Vec<_> = summary
+            .channels
+            .values()
+            .filter(|c| c.topic.starts_with("/effectors/"))
+            .collect();
+        assert_eq!(rods.len(), 4);
+        let effector_schemas: Vec<_> = summary
+            .schemas
+            .values()
+            .filter(|s| s.name.starts_with("polhode.effectors."))
+            .collect();
+        assert_eq!(effector_schemas.len(), 1, "{effector_schemas:?}");
+        assert_eq!(
+            effector_schemas[0].name,
+            "polhode.effectors.HingedRodFlapLag"
+        );
+        for c in &rods {
+            assert_eq!(
+                c.schema.as_ref().unwrap().id,
+                effector_schemas[0].id,
+                "{}",
+                c.topic
+            );
+        }
+        // Schema records in the file: one each for the 4 hub topics' and the rods' schema.
+        let stats = summary.stats.as_ref().unwrap();
+        assert_eq!((stats.schema_count, stats.channel_count), (5, 8));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// Instances of one kind with different fields get different schemas, named by variant.
+    #[test]
+    fn each_field_set_has_its_own_schema() {
+        let rod = |name: &str, freedom: &str, hinge: &str, direction: &str| {
+            format!(
+                "  - hinged_rod: {{name: {name}, mass: 0.1, length: 0.5, hinge: {hinge}, \
+                 direction: {direction}, axis: [0, 0, 1], freedom: {freedom}, stiffness: 1.0, \
+                 damping: 0.1, copies: {{count: 2, about: [0, 0, 1]}}}}\n"
+            )
+        };
+        let beam = |name: &str, modes: u32, bending: &str, z: f64| {
+            format!(
+                "  - modal_appendage: {{name: {name}, length: 2.0, bending_stiffness: 40.0, \
+                 mass_per_length: 0.4, tip_mass: 0.1, attachment: [0, 0, {z}], \
+                 direction: [0, 0, {z}], flap_direction: [1, 0, 0], modes: {modes}, \
+                 bending: {bending}}}\n"
+            )
+        };
+        let mut text = String::from(
+            "name: variants\nbody:\n  mass: 100.0\n  principal: [10.0, 12.0, 15.0]\n  \
+             spin_axis: [0, 0, 1]\n  shape: {box: {size: [2.0, 2.0, 2.0]}}\neffectors:\n",
+        );
+        text += &rod("a", "flap", "[0, 0.5, 0]", "[0, 1, 0]");
+        text += &rod("b", "lag", "[0.5, 0, 0.2]", "[1, 0, 0]");
+        text += &rod("c", "flap_lag", "[0.5, 0.5, -0.2]", "[0.6, 0.8, 0]");
+        text += &beam("m3", 3, "both", 1.0);
+        text += &beam("m5", 5, "flap", -1.0);
+        text += "  - spring_mass_damper: {name: d, mass: 1.0, position: [0.5, 0, 0], \
+                 direction: [0, 0, 1], stiffness: 1.0, damping: 0.5}\n\
+                 \x20 - wheel_damper: {name: w, inertia: 0.5, axis: [0, 0, 1], damping: 1.0, \
+                 position: [0, 0, 0.5]}\n\
+                 \x20 - rayleigh: {name: r, gamma_diagonal: [0.01, 0.01, 0.01]}\n\
+                 initial: {omega: [0.01, 0.0, 0.5]}\nduration: 1.0\n";
+        let dir = scratch("variants");
+        let (bytes, estimate) = run(&text, 0.05, Some(Compression::None), &dir.join("v.mcap"));
+        check_units(&bytes, "variants");
+        let summary = summary(&bytes);
+        let mut by_schema: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        for c in summary.channels.values() {
+            if let Some(e) = c.topic.strip_prefix("/effectors/") {
+                by_schema
+                    .entry(c.schema.as_ref().unwrap().name.clone())
+                    .or_default()
+                    .push(e.to_string());
+            }
+        }
+        for v in by_schema.values_mut() {
+            v.sort();
+        }
+        let expect: BTreeMap<String, Vec<String>> = [
+            ("HingedRodFlap", vec!["a_1", "a_2"]),
+            ("HingedRodLag", vec!["b_1", "b_2"]),
+            ("HingedRodFlapLag", vec!["c_1", "c_2"]),
+            ("ModalAppendageFlapLag3Modes", vec!["m3"]),
+            ("ModalAppendageFlap5Modes", vec!["m5"]),
+            ("SpringMassDamper", vec!["d"]),
+            ("WheelDamper", vec!["w"]),
+            ("Rayleigh", vec!["r"]),
+        ]
+        .into_iter()
+        .map(|(k, v)| {
+            (
+                format!("polhode.effectors.{k}"),
+                v.into_iter().map(String::from).collect(),
+            )
+        })
+        .collect();
+        assert_eq!(by_schema, expect);
+        assert_eq!(summary.schemas.len(), 4 + expect.len());
+        // A short run is all schemas and channels: the estimate must still cover them.
+        assert!(
+            bytes.len() as f64 <= estimate,
+            "{} bytes, estimated {estimate}",
+            bytes.len()
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The log-size estimate against an uncompressed log of a run with effectors.
+    #[test]
+    fn estimate_covers_the_log() {
+        let dir = scratch("estimate");
+        let (bytes, estimate) = run(
+            &shipped("explorer1-pydy.yaml"),
+            5.0,
+            Some(Compression::None),
+            &dir.join("e.mcap"),
+        );
+        let ratio = bytes.len() as f64 / estimate;
+        assert!((0.6..=1.0).contains(&ratio), "actual / estimate = {ratio}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// A name shared by two field sets (a kind whose variants the name does not tell apart)
+    /// gets a hash suffix for the second.
+    #[test]
+    fn a_schema_name_never_stands_for_two_field_sets() {
+        let mut registry = Registry::default();
+        let a: Vec<String> = ["sim_time", "x"].map(String::from).to_vec();
+        let b: Vec<String> = ["sim_time", "y"].map(String::from).to_vec();
+        assert_eq!(effector_schema_name(&registry, "new_kind", &a), "NewKind");
+        registry
+            .effector_schemas
+            .insert("NewKind".into(), a.clone());
+        assert_eq!(effector_schema_name(&registry, "new_kind", &a), "NewKind");
+        let other = effector_schema_name(&registry, "new_kind", &b);
+        assert!(
+            other.starts_with("NewKind_") && other.len() == 16,
+            "{other}"
+        );
     }
 }

@@ -2,20 +2,25 @@
 //!
 //! Flat double fields plot directly in Foxglove (`/telemetry.nutation_angle_deg`) and become
 //! plain columns in Rerun. The schema is a protobuf `FileDescriptorSet` built here, so readers
-//! decode with the schema embedded in the file and need no generated code.
+//! decode with the schema embedded in the file and need no generated code. Each field carries
+//! its description and unit as its protobuf comment (`source_code_info`, from
+//! [`super::units`]).
 
+use super::units;
 use crate::model::Observation;
 use crate::sim::Reference;
 use prost::Message;
 use prost_types::{
-    DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet,
+    DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet, SourceCodeInfo,
     field_descriptor_proto::{Label, Type},
+    source_code_info::Location,
 };
 
 /// Fully qualified schema name.
 pub const SCHEMA_NAME: &str = "polhode.Telemetry";
 
-/// Field names in field-number order (field `i` has number `i + 1`); units in `docs/logs.md`.
+/// Field names in field-number order (field `i` has number `i + 1`); units in [`units`] (the
+/// schema's field comments) and `docs/logs.md`.
 pub const FIELDS: [&str; 26] = [
     "sim_time",
     "omega_x",
@@ -47,12 +52,28 @@ pub const FIELDS: [&str; 26] = [
 
 /// The serialized `FileDescriptorSet` describing [`FIELDS`] as proto3 doubles.
 pub fn schema_bytes() -> Vec<u8> {
-    schema_for("polhode", "Telemetry", &FIELDS)
+    schema_for("polhode", "Telemetry", units::TELEMETRY, &FIELDS)
 }
 
 /// A `FileDescriptorSet` for message `package.message` whose fields are the doubles `names`
-/// (numbered from 1 in order).
-pub fn schema_for<S: AsRef<str>>(package: &str, message: &str, names: &[S]) -> Vec<u8> {
+/// (numbered from 1 in order), each with its description and unit (those of `kind` in
+/// [`units::field_unit`]) as its leading comment.
+///
+/// The comments are `source_code_info` locations with path `[4, 0, 2, i]` (message 0, field
+/// i) and spans as if the file were written out as
+///
+/// ```text
+/// 0  syntax = "proto3";
+/// 1
+/// 2  package <package>;
+/// 3
+/// 4  message <message> {
+/// 5    // <description> (<unit>).
+/// 6    double <name> = 1;
+///      …                      (field i: comment on line 5 + 2i, declaration on 6 + 2i)
+///    }
+/// ```
+pub fn schema_for<S: AsRef<str>>(package: &str, message: &str, kind: &str, names: &[S]) -> Vec<u8> {
     let fields = names
         .iter()
         .map(|n| n.as_ref())
@@ -66,6 +87,21 @@ pub fn schema_for<S: AsRef<str>>(package: &str, message: &str, names: &[S]) -> V
             ..Default::default()
         })
         .collect();
+    let location = names
+        .iter()
+        .map(|n| n.as_ref())
+        .enumerate()
+        .map(|(i, name)| {
+            let line = 6 + 2 * i as i32;
+            let declaration = format!("double {name} = {};", i + 1);
+            Location {
+                path: vec![4, 0, 2, i as i32],
+                span: vec![line, 2, 2 + declaration.chars().count() as i32],
+                leading_comments: Some(units::field_comment(kind, name)),
+                ..Default::default()
+            }
+        })
+        .collect();
     let file = FileDescriptorProto {
         name: Some(format!("{}/{message}.proto", package.replace('.', "/"))),
         package: Some(package.into()),
@@ -75,9 +111,28 @@ pub fn schema_for<S: AsRef<str>>(package: &str, message: &str, names: &[S]) -> V
             field: fields,
             ..Default::default()
         }],
+        source_code_info: Some(SourceCodeInfo { location }),
         ..Default::default()
     };
     FileDescriptorSet { file: vec![file] }.encode_to_vec()
+}
+
+/// The channel metadata `units` of a schema from [`schema_for`]: a JSON object from field
+/// name to unit, in field order (`""` for a field without a known unit).
+pub fn units_metadata<S: AsRef<str>>(kind: &str, names: &[S]) -> String {
+    let entries: Vec<String> = names
+        .iter()
+        .map(|n| {
+            let n = n.as_ref();
+            let unit = units::field_unit(kind, n).map_or("", |(_, u)| u);
+            format!(
+                "{}:{}",
+                serde_json::Value::from(n),
+                serde_json::Value::from(unit)
+            )
+        })
+        .collect();
+    format!("{{{}}}", entries.join(","))
 }
 
 /// The values of [`FIELDS`] for one observation.
@@ -163,5 +218,26 @@ mod tests {
         assert_eq!(msg.field.len(), FIELDS.len());
         assert_eq!(msg.field[16].name.as_deref(), Some("nutation_angle_deg"));
         assert_eq!(msg.field[16].number, Some(17));
+        let info = set.file[0].source_code_info.as_ref().unwrap();
+        assert_eq!(info.location.len(), FIELDS.len());
+        let loc = &info.location[1];
+        assert_eq!(loc.path, [4, 0, 2, 1]);
+        assert_eq!(
+            loc.leading_comments.as_deref(),
+            Some(" Body rate about body x (rad/s).\n")
+        );
+        assert_eq!(loc.span, [8, 2, 2 + "double omega_x = 2;".len() as i32]);
+    }
+
+    #[test]
+    fn units_metadata_is_json_in_field_order() {
+        let text = units_metadata(units::TELEMETRY, &FIELDS);
+        assert!(
+            text.starts_with(r#"{"sim_time":"s","omega_x":"rad/s","#),
+            "{text}"
+        );
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v.as_object().unwrap().len(), FIELDS.len());
+        assert_eq!(v["h_norm"], "N m s");
     }
 }
