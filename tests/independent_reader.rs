@@ -104,6 +104,24 @@ fn every_shipped_scenario_log_decodes() {
         run_polhode(&f, &out, if long { &["--duration", "20"] } else { &[] });
         let (code, text) = read(&out, &[]);
         assert_eq!(code, 0, "{}: {text}", f.display());
+        // The reader found every field's unit in the schemas' field comments.
+        let summary: serde_json::Value = serde_json::from_str(text.trim()).unwrap();
+        let units = &summary["units"];
+        assert_eq!(units["polhode.Telemetry"]["omega_x"], "rad/s", "{text}");
+        assert_eq!(units["polhode.Telemetry"]["h_norm"], "N m s", "{text}");
+        if f.ends_with("explorer1-pydy.yaml") {
+            // Four rods, one schema.
+            let schemas: Vec<&String> = units.as_object().unwrap().keys().collect();
+            assert_eq!(
+                schemas,
+                ["polhode.Telemetry", "polhode.effectors.HingedRodFlapLag"],
+                "{text}"
+            );
+            assert_eq!(
+                units["polhode.effectors.HingedRodFlapLag"]["flap_rate"],
+                "rad/s"
+            );
+        }
     }
 }
 

@@ -30,6 +30,14 @@ What it checks:
   schema encoding "protobuf":
       /tf -> foxglove.FrameTransforms     /scene -> foxglove.SceneUpdate
       /telemetry -> polhode.Telemetry     /log -> foxglove.Log
+  Units (every channel whose schema is a polhode.* one: /telemetry, /effectors/*)
+    - every field of the schema's FileDescriptorSet has a leading comment in its
+      source_code_info (path [4, message, 2, field]) ending in "(<unit>).", and
+      the unit equals that of the channel's "units" metadata (a JSON object);
+    - the units are in the JSON summary under "units", by schema name.
+  Effector schemas
+    - named per kind and field set: channels with the same schema name have the
+      same fields, and each schema name is registered once.
   Every message
     - decodes with its embedded schema; publish_time == log_time; log times are
       non-decreasing per topic in file order.
@@ -77,6 +85,7 @@ from collections import Counter, defaultdict
 from typing import Any
 
 try:
+    from google.protobuf import descriptor_pb2
     from google.protobuf.descriptor import FieldDescriptor
     from mcap.reader import make_reader
     from mcap_protobuf.decoder import DecoderFactory
@@ -254,6 +263,7 @@ class McapCheck:
         self.topic_counts: Counter = Counter()
         self.effector_samples: dict[str, int] = {}
         self.channel_topics: list[str] = []  # every topic in the summary, even without messages
+        self.units: dict[str, dict[str, str]] = {}  # schema name -> {field: unit}
         self.metadata_names: list[str] = []
         self.attachment_names: list[str] = []
         self.polhode_metadata: dict[str, str] = {}
@@ -370,6 +380,56 @@ class McapCheck:
                 )
             if not schema.data:
                 self.checks.fail("channels", f"{topic}: schema {schema.name!r} has no data")
+        self._check_units(summary)
+
+    def _check_units(self, summary) -> None:
+        """Every field of the polhode schemas documents its unit (see the module docstring)."""
+        names = [s.name for s in summary.schemas.values()]
+        for name in sorted(set(n for n in names if names.count(n) > 1)):
+            self.checks.fail("schemas", f"schema {name!r} is registered {names.count(name)} times")
+        for channel in sorted(summary.channels.values(), key=lambda c: c.topic):
+            schema = summary.schemas.get(channel.schema_id)
+            if schema is None or not schema.name.startswith("polhode."):
+                continue
+            where = f"{channel.topic} ({schema.name})"
+            try:
+                files = descriptor_pb2.FileDescriptorSet.FromString(schema.data).file
+                message = files[0].message_type[0]
+            except Exception as exc:
+                self.checks.fail("units", f"{where}: schema does not parse: {exc}")
+                continue
+            comments = {
+                tuple(loc.path): loc.leading_comments
+                for loc in files[0].source_code_info.location
+            }
+            try:
+                meta = json.loads(channel.metadata.get("units", ""))
+            except ValueError:
+                meta = None
+            if not isinstance(meta, dict):
+                self.checks.fail("units", f"{where}: no JSON 'units' channel metadata")
+                meta = {}
+            units: dict[str, str] = {}
+            for i, field in enumerate(message.field):
+                text = comments.get((4, 0, 2, i), "").strip()
+                unit = None
+                if text.endswith(").") and "(" in text:
+                    unit = text[text.rfind("(") + 1 : -2].strip()
+                if not unit:
+                    self.checks.fail(
+                        "units", f"{where}: field {field.name} has no unit in its comment {text!r}"
+                    )
+                    continue
+                if meta.get(field.name) != unit:
+                    self.checks.fail(
+                        "units",
+                        f"{where}: field {field.name}: comment unit {unit!r}, channel metadata "
+                        f"{meta.get(field.name)!r}",
+                    )
+                units[field.name] = unit
+            known = self.units.setdefault(schema.name, units)
+            if known != units:
+                self.checks.fail("units", f"{where}: fields or units differ between channels")
 
     def _linear_pass(self) -> None:
         """Read every record from start to end magic, decode every message, dispatch."""
@@ -734,6 +794,7 @@ class McapCheck:
             },
             "metadata": self.metadata_names,
             "attachments": self.attachment_names,
+            "units": self.units,
         }
         if not self.checks.ok:
             out["failures"] = self.checks.total
