@@ -11,8 +11,8 @@
 //!
 //! The nutation mode is the eigenvalue nearest the rigid-body nutation eigenvalue of the
 //! spacecraft with its effectors locked; the others are the effectors' own modes. Beside the
-//! nutation rate this module gives the classic energy-sink estimate of it (physics.md): drive
-//! the effectors with the locked body's nutation motion, average the power they dissipate
+//! nutation rate this module gives the classic energy-sink estimate of it (Hughes 1986, ch. 5):
+//! drive the effectors with the locked body's nutation motion, average the power they dissipate
 //! ⟨P⟩, and with |H| fixed let the excess energy ΔE = T − h²/(2 I_s) of the nutation decay
 //! (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is good for well-damped dampers only; the eigenvalue
 //! is the reference.
@@ -87,7 +87,7 @@ pub struct Linearization {
     /// when the effectors at rest are in equilibrium under the spin; a large value means the
     /// linearisation is about a point that is not steady.
     pub equilibrium_residual: f64,
-    /// The rigid-body closed form of physics.md for the same spin, effectors locked (an
+    /// The rigid-body closed form (Landau & Lifshitz §37) for the same spin, effectors locked (an
     /// independent check): growth rate k for the intermediate axis, nutation frequency
     /// otherwise.
     pub rigid_body_prediction: RigidPrediction,
@@ -242,7 +242,7 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let eig = jac.clone().complex_eigenvalues();
     let zero = 1e-9 * scale;
 
-    // The locked body's nutation eigenvalue (physics.md closed forms with the composite
+    // The locked body's nutation eigenvalue (Landau & Lifshitz §37 closed forms with the composite
     // moments), to pick out the nutation mode.
     let (i1, i2, i3) = (p[0], p[1], p[2]);
     let w = scale;
@@ -672,7 +672,8 @@ mod tests {
 
     #[test]
     fn tennis_racket_growth_rate_is_k() {
-        // physics.md: k = Ω sqrt((I3−I2)(I2−I1)/(I1 I3)) = 10·sqrt(0.5·1.5/3) = 5 1/s.
+        // Landau & Lifshitz §37: k = Ω sqrt((I3−I2)(I2−I1)/(I1 I3))
+        // = 10·sqrt(0.5·1.5/3) = 5 1/s.
         let sc = Spacecraft::new(
             RigidBody::from_principal([1.0, 2.5, 3.0]).unwrap(),
             Vector3::y(),
@@ -726,8 +727,9 @@ mod tests {
 
     use crate::effectors::{ParticleEffector, SpringMass, WheelDamper};
 
-    /// validation.md: Kasdin–Paley wheel damper, I_S/I_T = 1.5, I_W/I_T = 0.06, D/I_T = 0.5,
-    /// n = 2 rad/s: −0.010689 ± 1.001151i and −8.843869.
+    /// Eigenvalues of Kasdin & Paley's (2011) linearised wheel damper (docs/validation.md),
+    /// I_S/I_T = 1.5, I_W/I_T = 0.06, D/I_T = 0.5, n = 2 rad/s: −0.010689 ± 1.001151i and
+    /// −8.843869.
     #[test]
     fn kasdin_paley_wheel_damper_eigenvalues() {
         let hub = RigidBody::from_principal([1.0, 1.5, 1.0]).unwrap();
@@ -755,8 +757,9 @@ mod tests {
         assert!(lin.equilibrium_residual < 1e-15);
     }
 
-    /// validation.md: axial spring–mass damper, spin 1 rad/s about z, reduced mass 5 kg at
-    /// e = 1 m, k = 0.8 N/m, c = 5 N s/m, composite inertia diag(1000, 1000, I_s).
+    /// Axial spring–mass damper of docs/validation.md (eigenvalues computed independently),
+    /// spin 1 rad/s about z, reduced mass 5 kg at e = 1 m, k = 0.8 N/m, c = 5 N s/m, composite
+    /// inertia diag(1000, 1000, I_s).
     fn axial_damper(i_s: f64) -> Spacecraft {
         let mu = 5.0;
         let hub = RigidBody::from_principal([1000.0, 1000.0 - mu, i_s - mu]).unwrap();
@@ -854,9 +857,10 @@ mod tests {
         f
     }
 
-    /// validation.md: first flap frequency of a rotating cantilever 3.5160 (γ = 0), 7.3604
-    /// (γ = 6), 13.1702 (γ = 12); second flap 22.0345 (γ = 0); lag ω² = flap ω² − Ω². These
-    /// come from the foreshortening kinematics, not from a stiffness term put in by hand.
+    /// Wright, Smith, Thompson & Green (1982): first flap frequency of a rotating cantilever
+    /// 3.5160 (γ = 0), 7.3604 (γ = 6), 13.1702 (γ = 12); second flap 22.0345 (γ = 0); lag
+    /// ω² = flap ω² − Ω². These come from the foreshortening kinematics, not from a stiffness
+    /// term put in by hand.
     #[test]
     fn rotating_cantilever_frequencies_and_geometric_stiffening() {
         for (gamma, first) in [(0.0, 3.5160), (6.0, 7.3604), (12.0, 13.1702)] {

@@ -1,6 +1,7 @@
 //! Dissipation, dampers and appendages against things polhode did not produce: independent
 //! multibody integrations (tests/reference/*.py, sympy + SciPy), the eigenvalues of
-//! validation.md, the energy-sink identities of physics.md, and the flat spin of Explorer 1.
+//! published linearisations (docs/validation.md), the energy-sink identities (Hughes 1986,
+//! ch. 5), and the flat spin of Explorer 1.
 
 mod common;
 
@@ -264,7 +265,7 @@ fn measured_rate(sc: &Spacecraft, omega0: Vector3<f64>, period: f64, t_end: f64,
 }
 
 /// Kasdin–Paley wheel damper: the rate measured from a nonlinear run within 2% of the
-/// eigenvalue (validation.md: −0.010689 1/s).
+/// eigenvalue (docs/validation.md: −0.010689 1/s).
 #[test]
 fn wheel_damper_nonlinear_decay_matches_the_eigenvalue() {
     let hub = RigidBody::from_principal([1.0, 1.5, 1.0]).unwrap();
@@ -289,7 +290,7 @@ fn wheel_damper_nonlinear_decay_matches_the_eigenvalue() {
     );
 }
 
-/// Axial spring-mass damper (validation.md): decay with I_s = 1400, growth with I_s = 600,
+/// Axial spring-mass damper (docs/validation.md): decay with I_s = 1400, growth with I_s = 600,
 /// measured from nonlinear runs within 2% of −3.167e-3 and +7.238e-3 1/s.
 #[test]
 fn axial_damper_nonlinear_rates_match_the_eigenvalues() {
@@ -328,7 +329,8 @@ fn axial_damper_nonlinear_rates_match_the_eigenvalues() {
     }
 }
 
-/// Tip deflection (m) over the spin-up of physics.md, with and without the foreshortening.
+/// Tip deflection (m) over the spin-up of Kane, Ryan & Banerjee (1987), with and without the
+/// foreshortening.
 fn spin_up_tip(stiffening: bool) -> (f64, bool) {
     let modes = beam_modes(
         &BeamProperties {

@@ -1,4 +1,4 @@
-//! The free rigid body against the known answers of shared/validation.md and physics.md,
+//! The free rigid body against closed-form answers (Landau & Lifshitz §37; docs/validation.md),
 //! through the public run path (scenario → sim), for `exact` and tight `dopri5`.
 
 mod common;
@@ -22,8 +22,8 @@ fn rotation_about(q0: &UnitQuaternion<f64>, q1: &UnitQuaternion<f64>, axis: &Vec
     (2.0 * v.dot(&axis.normalize()).atan2(d.w)).rem_euclid(2.0 * PI)
 }
 
-/// validation.md "Free rigid body, exact solution": after one polhode period ω returns to ω0
-/// and the body has turned about H by Δ.
+/// Closed-form polhode periods 4K(m)/λ (docs/validation.md): after one polhode period ω returns to
+/// ω0 and the body has turned about H by Δ.
 #[test]
 fn polhode_period_and_rotation_angle() {
     let rows = [
@@ -51,7 +51,7 @@ fn polhode_period_and_rotation_angle() {
     }
 }
 
-/// validation.md "Intermediate-axis flip": I = (1, 2, 3), ω0 = (ε, 1, ε), ε = 1e-2: the time
+/// Intermediate-axis flip (docs/validation.md): I = (1, 2, 3), ω0 = (ε, 1, ε), ε = 1e-2: the time
 /// between flips (zero crossings of ω2) is 2K(m)/λ = 19.552867 s.
 #[test]
 fn flip_interval_matches_elliptic_half_period() {
@@ -83,7 +83,7 @@ fn flip_interval_matches_elliptic_half_period() {
     }
 }
 
-/// physics.md: spin Ω about the intermediate axis grows transverse errors as e^{kt},
+/// Landau & Lifshitz §37: spin Ω about the intermediate axis grows transverse errors as e^{kt},
 /// k = Ω sqrt((I3−I2)(I2−I1)/(I1 I3)). Measured from a simulated flip (least-squares slope of
 /// ln|ω1| while the motion is still linear), it must match within 1%.
 #[test]

@@ -4,7 +4,7 @@
 #
 #   scripts/slurm/submit.sh [--wait] SCENARIO OUTDIR SHARDS [extra polhode montecarlo args]
 #
-# e.g. scripts/slurm/submit.sh --wait scenarios/explorer1-pydy.yaml /shared/mc1 8 --runs 1000 --seed 7
+# e.g. scripts/slurm/submit.sh --wait scenarios/explorer1-pydy.yaml /cluster/mc1 8 --runs 1000 --seed 7
 #
 # Writes OUTDIR/shard-1 .. OUTDIR/shard-SHARDS, then OUTDIR/merged; SLURM logs go to
 # OUTDIR/logs/slurm-<array job>_<task>.out and OUTDIR/logs/slurm-<merge job>.out.

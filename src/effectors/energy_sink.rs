@@ -1,4 +1,5 @@
-//! `energy_sink`: the quasi-rigid model of internal energy dissipation (physics.md).
+//! `energy_sink`: the quasi-rigid model of internal energy dissipation (Thomson & Reiter
+//! 1960; Likins 1967; Hughes 1986, ch. 5).
 //!
 //! τ = −c (ω − (ω·Ĥ) Ĥ) with Ĥ = Iω/|Iω| (the hub's momentum direction, body axes). Then
 //! H·τ = 0, so |H| is kept (the direction of H_N is not: the torque is not a true internal

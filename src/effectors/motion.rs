@@ -5,7 +5,7 @@ use crate::model::HubMotion;
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
-/// The smooth spin-up of Kane, Ryan & Banerjee (1987), physics.md: hub angle
+/// The smooth spin-up of Kane, Ryan & Banerjee (J. Guidance 10(2), 1987): hub angle
 /// θ(t) = (Ω_s/T_s)[t²/2 + (T_s/2π)²(cos(2πt/T_s) − 1)] for t ≤ T_s, Ω_s t − Ω_s T_s/2 after,
 /// about a body axis â (which stays fixed in inertial space).
 #[derive(Debug, Clone)]

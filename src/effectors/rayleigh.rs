@@ -1,9 +1,9 @@
 //! `rayleigh`: a Rayleigh dissipation function R = ½ ωᵀ Γ ω (Γ symmetric positive
 //! semi-definite) and its torque τ = −∂R/∂ω = −Γ ω.
 //!
-//! Then dT/dt = ωᵀ τ = −2R exactly. The torque acts like external friction: it drains |H| as
-//! well as energy (physics.md). One bookkeeping state, the dissipated energy (Ẇ = 2R), closes
-//! the energy balance T + W = T₀.
+//! Then dT/dt = ωᵀ τ = −2R exactly. The torque acts like external friction: it drains |H| as well
+//! as energy (Rayleigh's dissipation function: Goldstein, *Classical Mechanics*, §1.5). One
+//! bookkeeping state, the dissipated energy (Ẇ = 2R), closes the energy balance T + W = T₀.
 
 use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
 use nalgebra::Matrix3;

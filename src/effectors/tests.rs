@@ -182,7 +182,8 @@ fn explorer_rods(k: f64, c: f64) -> Spacecraft {
 
 #[test]
 fn explorer1_initial_momentum_energy_and_nutation_match_validation() {
-    // validation.md: |H| = 11.806 N m s, T = 463.16 J, nutation 2.668°.
+    // Closed-form values of the PyDy Explorer model (docs/validation.md):
+    // |H| = 11.806 N m s, T = 463.16 J, nutation 2.668°.
     let sc = explorer_rods(0.565, 1.13);
     let y0 = sc.initial_state(
         &Vector3::new(0.0785, 0.0785, 78.54),

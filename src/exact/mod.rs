@@ -728,10 +728,10 @@ impl TorqueFreeSolution {
         self.m1
     }
 
-    /// Time scale λ (1/s) of the elliptic solution, τ = λ t + c (physics.md). Symmetric body:
-    /// |k| = |ω_s (I_s − I_t)/I_t|, the polhode rate; pure spin: the limit for vanishing
-    /// nutation (axes 1, 3: small-oscillation frequency; axis 2: instability growth rate);
-    /// rest and spherical: 0.
+    /// Time scale λ (1/s) of the elliptic solution, τ = λ t + c (Landau & Lifshitz §37). Symmetric
+    /// body: |k| = |ω_s (I_s − I_t)/I_t|, the polhode rate; pure spin: the limit for vanishing
+    /// nutation (axes 1, 3: small-oscillation frequency; axis 2: instability growth rate); rest and
+    /// spherical: 0.
     pub fn lambda(&self) -> f64 {
         self.lambda
     }

@@ -255,7 +255,7 @@ fn near_separatrix_1e8() {
 }
 
 // ---------------------------------------------------------------------------------------
-// validation.md rows
+// The closed-form period table of docs/validation.md (Landau & Lifshitz §37)
 
 #[test]
 fn validation_rows() {
@@ -542,7 +542,7 @@ fn regimes_and_degenerate_cases() {
         let expect = q0 * UnitQuaternion::from_scaled_axis(w0 * 3.0);
         assert!(angle_between(&q, expect.quaternion()) < 1e-15);
         // λ is the small-oscillation frequency (axes 1, 3) or growth rate (axis 2) of
-        // physics.md.
+        // the linearised Euler equations (Landau & Lifshitz §37).
         let om = w0.norm();
         let lam = match axis {
             1 => om * ((2.0 - 1.0) * (3.0 - 1.0) / (2.0 * 3.0f64)).sqrt(),

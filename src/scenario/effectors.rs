@@ -221,7 +221,7 @@ pub struct ModalSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
 pub enum HubMotionSpec {
-    /// The smooth spin-up of physics.md.
+    /// The smooth spin-up of Kane, Ryan & Banerjee (1987).
     SpinUp {
         /// Spin axis (body axes).
         axis: Spanned<[f64; 3]>,
