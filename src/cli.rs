@@ -686,7 +686,7 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
         lin.principal_moments[2]
     );
     println!(
-        "  {:>16} {:>16}  {:<12} {:<9} time constant",
+        "  {:>16} {:>16}  {:<12} {:<10} time constant",
         "Re (1/s)", "Im (rad/s)", "mode", "role"
     );
     for m in &lin.modes {
@@ -695,11 +695,12 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
             .map(|t| format!("{t:.6} s"))
             .unwrap_or_else(|| "-".into());
         println!(
-            "  {:>16.9e} {:>16.9e}  {:<12} {:<9} {tc}",
+            "  {:>16.9e} {:>16.9e}  {:<12} {:<10} {tc}",
             m.re, m.im, m.kind, m.role
         );
     }
     println!("  verdict: {}", lin.verdict);
+    print_spin_decay_and_gyrostat(lin);
     if let Some(n) = &lin.nutation {
         let what = if n.rate > 0.0 { "grows" } else { "decays" };
         match n.time_constant {
@@ -736,13 +737,58 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
         );
     }
     let r = &lin.rigid_body_prediction;
-    if r.growth_rate > 0.0 {
-        println!("  rigid-body closed form: k = {:.9e} 1/s", r.growth_rate);
+    let form = if lin.gyrostat.is_some() {
+        "gyrostat closed form (rotors locked at their relative rates)"
     } else {
+        "rigid-body closed form"
+    };
+    if r.growth_rate > 0.0 {
+        println!("  {form}: k = {:.9e} 1/s", r.growth_rate);
+    } else {
+        println!("  {form}: nutation frequency {:.9e} rad/s", r.frequency);
+    }
+}
+
+/// The `linearize` lines on the spin's own decay (an external torque) and on a gyrostat's
+/// spinning rotors.
+fn print_spin_decay_and_gyrostat(lin: &Linearization) {
+    if let Some(m) = lin.modes.iter().find(|m| m.role == "spin_decay") {
+        let tc = m
+            .time_constant
+            .map(|t| format!(" (time constant {t:.6} s)"))
+            .unwrap_or_default();
         println!(
-            "  rigid-body closed form: nutation frequency {:.9e} rad/s",
-            r.frequency
+            "  spin decay: {:.9e} 1/s{tc}; an external torque drains |H|, so the spin is not \
+             steady but decays (expected): the modes are those about the spin at this rate",
+            m.re
         );
+    }
+    let Some(g) = &lin.gyrostat else { return };
+    println!(
+        "  gyrostat: rotor momentum h = {:.9e} N m s along the spin axis",
+        g.rotor_momentum
+    );
+    match (g.rotor_decay_rate, g.rotor_decay_time_constant) {
+        (Some(r), Some(tc)) => {
+            let periods = g
+                .nutation_periods_per_decay
+                .map(|n| format!(", {n:.3e} nutation periods"))
+                .unwrap_or_default();
+            println!(
+                "  {}: a damped rotor's relative rate decays at {r:.9e} 1/s (time constant \
+                 {tc:.6} s{periods}); linearised about the rate frozen at its initial value",
+                g.equilibrium
+            );
+            if g.equilibrium == "not steady" {
+                println!(
+                    "  warning: the rotor's relative rate decays within {} nutation periods, \
+                     so the frozen-rate linearisation does not describe the motion; give the \
+                     rotor less damping, or start it at rest",
+                    crate::linearize::QUASI_STEADY_PERIODS
+                );
+            }
+        }
+        _ => println!("  {}: every spinning rotor is frictionless", g.equilibrium),
     }
 }
 

@@ -2,20 +2,32 @@
 //!
 //! The equilibrium is spin at rate Ω about the scenario's spin axis ŝ (which must be a
 //! principal axis of the whole spacecraft with its effectors at rest, or no steady spin
-//! exists), with every effector at rest. The Jacobian of the rate dynamics (ω and the
-//! effectors' dynamic states; the attitude does not feed back in a torque-free or
-//! internal-effector scene, and bookkeeping states such as dissipated energy are left out) is
-//! taken by central differences of the full right-hand side, so it covers whatever effectors
-//! the spacecraft has. For the rigid body the rate equations are quadratic, so central
-//! differences are exact up to rounding.
+//! exists), with every effector at rest, except that a rotor (`wheel_damper`) keeps the
+//! relative rate the scenario starts it at: with a spinning rotor the spacecraft is a
+//! gyrostat, H = Iω + Σ I_W Ω â, and its steady spin about ŝ needs every spinning rotor's
+//! axis along ŝ (a rotor across ŝ moves the steady spin off ŝ; refused). A frictionless
+//! rotor (D = 0) makes that an exact equilibrium; a damped one (D > 0) does not (the relative
+//! rate relaxes), and the linearisation is then about the frozen relative rate, a
+//! quasi-steady state whose decay time is reported beside the nutation's. The Jacobian of the
+//! rate dynamics (ω and the effectors' dynamic states; the attitude does not feed back in a
+//! torque-free or internal-effector scene, and bookkeeping states such as dissipated energy
+//! are left out) is taken by central differences of the full right-hand side, so it covers
+//! whatever effectors the spacecraft has. For the rigid body the rate equations are
+//! quadratic, so central differences are exact up to rounding.
 //!
-//! The nutation mode is the eigenvalue nearest the rigid-body nutation eigenvalue of the
-//! spacecraft with its effectors locked; the others are the effectors' own modes. Beside the
-//! nutation rate this module gives the classic energy-sink estimate of it (Hughes 1986, ch. 5):
-//! drive the effectors with the locked body's nutation motion, average the power they dissipate
-//! ⟨P⟩, and with |H| fixed let the excess energy ΔE = T − h²/(2 I_s) of the nutation decay
-//! (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is good for well-damped dampers only; the eigenvalue
-//! is the reference.
+//! The spin mode is the eigenvalue nearest ŝᵀ J_ωω ŝ: zero when nothing drains |H|, the spin's
+//! own decay rate (`spin_decay`, about −ŝᵀΓŝ/I_s) under an external torque such as a Rayleigh
+//! torque −Γω, which has no states of its own. Every frictionless rotor adds one more zero
+//! eigenvalue (its absolute axial momentum is conserved: a change of its rate is steady too),
+//! labelled kind `rotor`. The nutation mode is the eigenvalue nearest the nutation eigenvalue
+//! of the spacecraft with its effectors locked (rotors locked at their relative rates: the
+//! gyrostat closed form λ² = −[(I_s − I_a)Ω + h][(I_s − I_b)Ω + h]/(I_a I_b)); the others
+//! are the effectors' own modes. Beside the nutation rate this module gives the classic
+//! energy-sink estimate of it (Hughes 1986, ch. 5): drive the effectors with the locked
+//! body's nutation motion, average the power they dissipate ⟨P⟩, and with |H| fixed let the excess
+//! energy ΔE = T − h²/(2 I_s) of the nutation decay (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is
+//! good for well-damped dampers only (and not given for a gyrostat, whose energy function
+//! differs); the eigenvalue is the reference.
 
 use crate::effectors::EnergySink;
 use crate::integrate::OdeSystem;
@@ -31,11 +43,14 @@ pub struct Mode {
     pub re: f64,
     /// Imaginary part: angular frequency (rad/s).
     pub im: f64,
-    /// `spin` (the neutral direction along ŝ), `growing`, `decaying`, `oscillating` or
-    /// `neutral`.
+    /// `spin` (the neutral direction along ŝ), `rotor` (the neutral direction of a
+    /// frictionless rotor's relative rate), `growing`, `decaying`, `oscillating` or `neutral`
+    /// (a further zero eigenvalue: the linearisation is degenerate).
     pub kind: String,
-    /// `spin`, `nutation` (the rigid body's wobble, modified by the effectors) or `effector`
-    /// (an effector's own mode: a damper's or an appendage's).
+    /// `spin`, `spin_decay` (the spin mode when an external torque such as a Rayleigh torque
+    /// drains |H|: its real part is the spin's decay rate), `nutation` (the rigid body's
+    /// wobble, modified by the effectors) or `effector` (an effector's own mode: a damper's,
+    /// an appendage's or a rotor's).
     pub role: String,
     /// 1/|re| (s), when the mode grows or decays.
     pub time_constant: Option<f64>,
@@ -83,23 +98,94 @@ pub struct Linearization {
     pub time_constant: Option<f64>,
     /// The nutation mode, when one is identified.
     pub nutation: Option<Nutation>,
-    /// Largest |ẏ| at the equilibrium relative to Ω (and 1 for effector states): near zero
-    /// when the effectors at rest are in equilibrium under the spin; a large value means the
-    /// linearisation is about a point that is not steady.
+    /// Largest |ẏ| at the equilibrium relative to Ω² (and 1 for effector states), leaving out
+    /// the drifts that are expected and reported elsewhere (the spin's own decay along ŝ
+    /// under an external torque, see the `spin_decay` mode; a damped rotor trading its
+    /// relative rate with the hub, see `gyrostat`): near zero when the effectors at rest are
+    /// in equilibrium under the spin; a large value means the linearisation is about a point
+    /// that is not steady.
     pub equilibrium_residual: f64,
-    /// The rigid-body closed form (Landau & Lifshitz §37) for the same spin, effectors locked (an
-    /// independent check): growth rate k for the intermediate axis, nutation frequency
-    /// otherwise.
+    /// The closed form for the same spin with the effectors locked (an independent check):
+    /// the rigid body's (Landau & Lifshitz §37) growth rate k for the intermediate axis,
+    /// nutation frequency otherwise; with spinning rotors, the locked gyrostat's
+    /// λ² = −[(I_s − I_a)Ω + h][(I_s − I_b)Ω + h]/(I_a I_b).
     pub rigid_body_prediction: RigidPrediction,
+    /// Present when a rotor spins relative to the hub (a gyrostat).
+    pub gyrostat: Option<Gyrostat>,
 }
 
-/// Closed-form small-motion prediction for a rigid body spinning about a principal axis.
+/// A gyrostat's steady spin: rotors spinning relative to the hub, their axes along ŝ.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Gyrostat {
+    /// h = Σ I_W Ω₀ â·ŝ: the rotors' relative angular momentum along ŝ (N m s).
+    pub rotor_momentum: f64,
+    /// `exact` (every spinning rotor frictionless: a true equilibrium), `quasi-steady` (a
+    /// damped rotor's relative rate decays, but over at least [`QUASI_STEADY_PERIODS`]
+    /// nutation periods: the linearisation is about its frozen rate) or `not steady` (it
+    /// decays faster than that: the frozen-rate linearisation does not describe the motion).
+    pub equilibrium: String,
+    /// Relaxation rate of the fastest-decaying damped spinning rotor's relative rate,
+    /// −∂Ω̇/∂Ω from the Jacobian (1/s); for one rotor on the spin axis D I_s / (I_W (I_s − I_W)).
+    pub rotor_decay_rate: Option<f64>,
+    /// 1/`rotor_decay_rate` (s).
+    pub rotor_decay_time_constant: Option<f64>,
+    /// Nutation periods within that time constant: `rotor_decay_time_constant` · |λ| / 2π,
+    /// λ the nutation eigenvalue.
+    pub nutation_periods_per_decay: Option<f64>,
+}
+
+/// Nutation periods a damped rotor's relative rate must last (its decay time constant) for the
+/// frozen-rate linearisation to count as quasi-steady.
+pub const QUASI_STEADY_PERIODS: f64 = 10.0;
+
+/// Closed-form small-motion prediction for a rigid body (or a gyrostat with its rotors
+/// locked at their relative rates) spinning about a principal axis.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct RigidPrediction {
-    /// Growth rate k (1/s) for the intermediate axis, 0 otherwise.
+    /// Growth rate k (1/s) when the locked body is unstable (the intermediate axis of a rigid
+    /// body), 0 otherwise.
     pub growth_rate: f64,
-    /// Nutation angular frequency (rad/s) for the minor or major axis, 0 otherwise.
+    /// Nutation angular frequency (rad/s) otherwise (minor or major axis), 0 when unstable.
     pub frequency: f64,
+}
+
+/// A rotor (`wheel_damper`), read through the generic effector interface.
+struct Rotor {
+    /// Its name.
+    name: String,
+    /// Position of its relative rate Ω in the state vector.
+    index: usize,
+    /// I_W â: its momentum per unit relative rate (N m s per rad/s), body axes.
+    momentum_per_rate: Vector3<f64>,
+    /// Viscous coefficient D (N m s/rad): the power it dissipates at Ω = 1 rad/s.
+    damping: f64,
+    /// The relative rate the scenario starts it at, Ω₀ (rad/s).
+    rate: f64,
+}
+
+/// The spacecraft's rotors: their momentum and dissipation per unit rate measured with the hub
+/// at rest and everything else at rest.
+fn rotors(sc: &Spacecraft) -> Vec<Rotor> {
+    let rest = sc.rest_state(&Vector3::zeros(), &UnitQuaternion::identity());
+    let base = sc.invariants(0.0, &rest);
+    sc.effectors()
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.kind() == "wheel_damper")
+        .map(|(k, e)| {
+            let index = sc.effector_offset(k);
+            let mut y = rest.clone();
+            y[index] = 1.0;
+            let unit = sc.invariants(0.0, &y);
+            Rotor {
+                name: e.name().to_string(),
+                index,
+                momentum_per_rate: unit.h_body - base.h_body,
+                damping: unit.dissipation_power - base.dissipation_power,
+                rate: e.initial_state().first().copied().unwrap_or(0.0),
+            }
+        })
+        .collect()
 }
 
 /// Principal moments (ascending) and axes (columns) of a symmetric tensor.
@@ -201,8 +287,44 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         ));
     }
 
+    // Rotors spinning relative to the hub make a gyrostat: they keep their relative rate in
+    // the steady state, and their momentum must lie along ŝ for the hub's steady spin to be
+    // about ŝ (ω × (Iω + h) = 0 with Iŝ ∥ ŝ needs h ∥ ŝ).
+    let rotors = rotors(sc);
+    for r in rotors.iter().filter(|r| r.rate != 0.0) {
+        let m = r.momentum_per_rate;
+        let across = m.cross(&s).norm() / m.norm().max(f64::MIN_POSITIVE);
+        if across > 1e-9 {
+            let a = m.normalize();
+            return Err(format!(
+                "rotor `{}` spins relative to the hub (initial_rate {} rad/s) about [{:.6}, \
+                 {:.6}, {:.6}], {:.3e}° off the spin axis: its momentum across ŝ puts the \
+                 gyrostat's steady spin about an axis where Iω + h is parallel to ω, not about \
+                 ŝ, and this linearisation does not solve for that axis; put the rotor's axis \
+                 along the spin axis, or start it at rest (initial_rate 0)",
+                r.name,
+                r.rate,
+                a[0],
+                a[1],
+                a[2],
+                across.min(1.0).asin().to_degrees()
+            ));
+        }
+    }
+    // h: the rotors' relative momentum along ŝ.
+    let h_rotor: f64 = rotors
+        .iter()
+        .map(|r| r.rate * r.momentum_per_rate.dot(&s))
+        .sum();
+    let spinning = rotors.iter().any(|r| r.rate != 0.0);
+    let damped_spinning = rotors.iter().any(|r| r.rate != 0.0 && r.damping != 0.0);
+    let external = sc.effectors().iter().any(|e| e.is_external());
+
     let omega = s * spin_rate;
-    let y_eq = sc.rest_state(&omega, &UnitQuaternion::identity());
+    let mut y_eq = sc.rest_state(&omega, &UnitQuaternion::identity());
+    for r in &rotors {
+        y_eq[r.index] = r.rate;
+    }
     let n = sc.dim();
     // Linearised coordinates: ω and the effectors' dynamic states.
     let (effector_idx, effector_names) = dynamic_states(sc);
@@ -215,16 +337,23 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let scale = spin_rate.abs();
     let mut f0 = vec![0.0; n];
     sc.rhs(0.0, &y_eq, &mut f0);
-    let equilibrium_residual = idx
+    // Expected drifts are left out: along ŝ when an external torque drains the spin or a
+    // damped rotor trades momentum with the hub, and a damped spinning rotor's own rate.
+    let w_dot = Vector3::new(f0[0], f0[1], f0[2]);
+    let hub_residual = if external || damped_spinning {
+        (w_dot - s * s.dot(&w_dot)).norm()
+    } else {
+        w_dot.amax()
+    } / (scale * scale);
+    let equilibrium_residual = idx[3..]
         .iter()
-        .map(|&i| {
-            if i < 3 {
-                f0[i].abs() / (scale * scale)
-            } else {
-                f0[i].abs()
-            }
+        .filter(|&&i| {
+            !rotors
+                .iter()
+                .any(|r| r.index == i && r.rate != 0.0 && r.damping != 0.0)
         })
-        .fold(0.0, f64::max);
+        .map(|&i| f0[i].abs())
+        .fold(hub_residual, f64::max);
     let m = idx.len();
     let mut dy = vec![0.0; n];
     let step = |j: usize| {
@@ -242,72 +371,99 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let eig = jac.clone().complex_eigenvalues();
     let zero = 1e-9 * scale;
 
-    // The locked body's nutation eigenvalue (Landau & Lifshitz §37 closed forms with the composite
-    // moments), to pick out the nutation mode.
+    // The locked body's nutation eigenvalue, to pick out the nutation mode. With the
+    // composite moments (I_s about ŝ, I_a and I_b the other two) and the rotors locked at
+    // their relative rates (momentum h along ŝ), the transverse Euler equations
+    // I_a δω̇_a = [(I_b − I_s)Ω − h] δω_b, I_b δω̇_b = [(I_s − I_a)Ω + h] δω_a give
+    // λ² = −[(I_s − I_a)Ω + h][(I_s − I_b)Ω + h]/(I_a I_b): when h = 0, the rigid body's k
+    // and ν (Landau & Lifshitz §37).
     let (i1, i2, i3) = (p[0], p[1], p[2]);
-    let w = scale;
-    let rigid = match principal_index {
-        1 => RigidPrediction {
-            growth_rate: w * ((i3 - i2) * (i2 - i1) / (i1 * i3)).sqrt(),
-            frequency: 0.0,
-        },
-        0 => RigidPrediction {
-            growth_rate: 0.0,
-            frequency: w * ((i2 - i1) * (i3 - i1) / (i2 * i3)).sqrt(),
-        },
-        _ => RigidPrediction {
-            growth_rate: 0.0,
-            frequency: w * ((i3 - i1) * (i3 - i2) / (i1 * i2)).sqrt(),
-        },
+    let i_spin = p[principal_index];
+    let [i_a, i_b] = match principal_index {
+        0 => [i2, i3],
+        1 => [i1, i3],
+        _ => [i1, i2],
     };
+    let lambda_sq = -((i_spin - i_a) * spin_rate + h_rotor)
+        * ((i_spin - i_b) * spin_rate + h_rotor)
+        / (i_a * i_b);
+    let rigid = if lambda_sq > 0.0 {
+        RigidPrediction {
+            growth_rate: lambda_sq.sqrt(),
+            frequency: 0.0,
+        }
+    } else {
+        RigidPrediction {
+            growth_rate: 0.0,
+            frequency: (-lambda_sq).sqrt(),
+        }
+    };
+
+    // The spin mode: the eigenvalue nearest ŝᵀ J_ωω ŝ (the spin's rate of change per change
+    // of spin rate; zero unless an external torque acts along ŝ).
+    let j_ww = Matrix3::from_fn(|r, c| jac[(r, c)]);
+    let spin_estimate = C64::new(s.dot(&(j_ww * s)), 0.0);
+    let spin_index = (0..eig.len())
+        .min_by(|&a, &b| {
+            (eig[a] - spin_estimate)
+                .norm()
+                .total_cmp(&(eig[b] - spin_estimate).norm())
+        })
+        .unwrap_or(0);
+    let spin_decays = external && eig[spin_index].norm() > zero;
+    // Each frictionless rotor's conserved absolute momentum I_W (Ω + â·ω) gives one more
+    // zero eigenvalue.
+    let mut free_rotors = rotors.iter().filter(|r| r.damping == 0.0).count();
+    let mut by_size: Vec<usize> = (0..eig.len()).filter(|&k| k != spin_index).collect();
+    by_size.sort_by(|&a, &b| eig[a].norm().total_cmp(&eig[b].norm()));
+    let mut rotor_zero = vec![false; eig.len()];
+    for &k in &by_size {
+        if free_rotors > 0 && eig[k].norm() <= zero {
+            rotor_zero[k] = true;
+            free_rotors -= 1;
+        }
+    }
+    let candidate = |k: usize| k != spin_index && !rotor_zero[k] && eig[k].norm() > zero;
+
     let rigid_eigenvalue = C64::new(rigid.growth_rate, rigid.frequency);
     let nutation_index = (rigid_eigenvalue.norm() > zero)
         .then(|| {
-            eig.iter()
-                .enumerate()
-                .filter(|(_, z)| z.im >= 0.0 && z.norm() > zero)
-                .min_by(|a, b| {
-                    (a.1 - rigid_eigenvalue)
+            (0..eig.len())
+                .filter(|&k| candidate(k) && eig[k].im >= 0.0)
+                .min_by(|&a, &b| {
+                    (eig[a] - rigid_eigenvalue)
                         .norm()
-                        .total_cmp(&(b.1 - rigid_eigenvalue).norm())
+                        .total_cmp(&(eig[b] - rigid_eigenvalue).norm())
                 })
-                .map(|(k, _)| k)
         })
         .flatten();
     let nutation_value = nutation_index.map(|k| eig[k]);
-    // The intermediate axis's rigid pair is ±k (real): its decaying partner, the eigenvalue
+    // An unstable locked body's pair is ±k (real): its decaying partner, the eigenvalue
     // nearest −k, belongs to the nutation too. (A complex mode's partner is its conjugate.)
     let partner = (rigid.growth_rate > 0.0)
         .then(|| {
-            eig.iter()
-                .filter(|z| z.norm() > zero)
-                .min_by(|a, b| {
-                    (*a + rigid_eigenvalue)
+            (0..eig.len())
+                .filter(|&k| candidate(k) && Some(k) != nutation_index)
+                .min_by(|&a, &b| {
+                    (eig[a] + rigid_eigenvalue)
                         .norm()
-                        .total_cmp(&(*b + rigid_eigenvalue).norm())
+                        .total_cmp(&(eig[b] + rigid_eigenvalue).norm())
                 })
-                .copied()
+                .map(|k| eig[k])
         })
         .flatten();
 
-    // One zero eigenvalue belongs to the spin itself (a change of spin rate is steady too).
-    // Further zero eigenvalues make the linearisation degenerate (e.g. a symmetric body spun
-    // about a transverse axis): they are `neutral`, and the verdict says the linear theory
-    // cannot decide.
-    let mut spin_seen = false;
+    // One eigenvalue belongs to the spin itself (a change of spin rate is steady too, or
+    // decays under an external torque), one zero to each frictionless rotor. Further zero
+    // eigenvalues make the linearisation degenerate (e.g. a symmetric body spun about a
+    // transverse axis): they are `neutral`, and the verdict says the linear theory cannot
+    // decide.
     let mut modes: Vec<Mode> = eig
         .iter()
-        .map(|z| {
+        .enumerate()
+        .map(|(k, z)| {
             let mut role = "effector";
-            let kind = if z.norm() <= zero {
-                if spin_seen {
-                    "neutral"
-                } else {
-                    spin_seen = true;
-                    role = "spin";
-                    "spin"
-                }
-            } else if z.re > zero {
+            let motion = if z.re > zero {
                 "growing"
             } else if z.re < -zero {
                 "decaying"
@@ -316,13 +472,26 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             } else {
                 "neutral"
             };
-            let same = |v: C64| {
-                (z.re - v.re).abs() <= 1e-12 * v.norm()
-                    && (z.im.abs() - v.im.abs()).abs() <= 1e-12 * v.norm()
+            let kind = if k == spin_index {
+                if spin_decays {
+                    role = "spin_decay";
+                    motion
+                } else {
+                    role = "spin";
+                    "spin"
+                }
+            } else if rotor_zero[k] {
+                "rotor"
+            } else {
+                let same = |v: C64| {
+                    (z.re - v.re).abs() <= 1e-12 * v.norm()
+                        && (z.im.abs() - v.im.abs()).abs() <= 1e-12 * v.norm()
+                };
+                if candidate(k) && (nutation_value.is_some_and(same) || partner.is_some_and(same)) {
+                    role = "nutation";
+                }
+                motion
             };
-            if nutation_value.is_some_and(same) || partner.is_some_and(same) {
-                role = "nutation";
-            }
             Mode {
                 re: z.re,
                 im: z.im,
@@ -335,7 +504,7 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     modes.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
     let max_growth_rate = modes
         .iter()
-        .filter(|m| m.kind != "spin")
+        .filter(|m| m.kind != "spin" && m.kind != "rotor" && m.role != "spin_decay")
         .map(|m| m.re)
         .reduce(f64::max)
         .unwrap_or(0.0);
@@ -352,7 +521,7 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     };
 
     let nutation = nutation_value.map(|v| {
-        let estimate = (rigid.frequency > 0.0)
+        let estimate = (rigid.frequency > 0.0 && !spinning)
             .then(|| energy_sink_estimate(sc, &y_eq, &idx, &inertia, &s, rigid.frequency))
             .flatten();
         Nutation {
@@ -361,6 +530,34 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             time_constant: (v.re.abs() > zero).then(|| 1.0 / v.re.abs()),
             energy_sink_rate: estimate,
             energy_sink_time_constant: estimate.filter(|r| r.abs() > 0.0).map(|r| 1.0 / r.abs()),
+        }
+    });
+
+    let gyrostat = spinning.then(|| {
+        // −∂Ω̇/∂Ω of each damped spinning rotor, from the Jacobian's diagonal.
+        let rotor_decay_rate = rotors
+            .iter()
+            .filter(|r| r.rate != 0.0 && r.damping != 0.0)
+            .filter_map(|r| idx.iter().position(|&i| i == r.index))
+            .map(|c| -jac[(c, c)])
+            .reduce(f64::max);
+        let rotor_decay_time_constant = rotor_decay_rate.filter(|r| *r > 0.0).map(|r| 1.0 / r);
+        let nutation_periods_per_decay = rotor_decay_time_constant
+            .zip(nutation_value)
+            .map(|(tc, v)| tc * v.norm() / std::f64::consts::TAU);
+        let equilibrium = if !damped_spinning {
+            "exact"
+        } else if nutation_periods_per_decay.is_some_and(|n| n < QUASI_STEADY_PERIODS) {
+            "not steady"
+        } else {
+            "quasi-steady"
+        };
+        Gyrostat {
+            rotor_momentum: h_rotor,
+            equilibrium: equilibrium.into(),
+            rotor_decay_rate,
+            rotor_decay_time_constant,
+            nutation_periods_per_decay,
         }
     });
 
@@ -380,6 +577,7 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         nutation,
         equilibrium_residual,
         rigid_body_prediction: rigid,
+        gyrostat,
     })
 }
 
