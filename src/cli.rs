@@ -267,13 +267,41 @@ impl MethodArgs {
     }
 }
 
+/// Adds a "similar subcommand" tip where clap's own (Jaro similarity) finds none: transposed
+/// letters (`rnu` → `run`) and up to two typos by Damerau–Levenshtein distance.
+fn suggest_subcommand(e: &mut clap::Error) {
+    use clap::CommandFactory;
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::InvalidSubcommand || e.get(ContextKind::SuggestedSubcommand).is_some()
+    {
+        return;
+    }
+    let Some(ContextValue::String(typed)) = e.get(ContextKind::InvalidSubcommand) else {
+        return;
+    };
+    let typed = typed.clone();
+    let best = Cli::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .map(|name| (strsim::damerau_levenshtein(&typed, &name), name))
+        .filter(|(d, name)| *d <= 2 && *d < name.len())
+        .min();
+    if let Some((_, name)) = best {
+        e.insert(
+            ContextKind::SuggestedSubcommand,
+            ContextValue::Strings(vec![name]),
+        );
+    }
+}
+
 /// Runs the command line; returns the process exit code.
 pub fn main() -> i32 {
     ignore_file_size_signal();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
-        Err(e) => {
+        Err(mut e) => {
             let code = if e.use_stderr() { EXIT_BAD_INPUT } else { 0 };
+            suggest_subcommand(&mut e);
             let _ = e.print();
             return code;
         }
@@ -578,21 +606,44 @@ fn compare_cmd(
     }
 }
 
+/// Validates whole files, `montecarlo:` block included (with `polhode montecarlo`'s own
+/// checks and messages), without running anything.
 fn check(paths: &[PathBuf]) -> i32 {
     let mut code = 0;
     for p in paths {
-        match load(p, &Overrides::default()) {
-            Ok(s) => println!(
-                "{}: ok ({}; {} s; {}; {} Hz to {})",
-                p.display(),
-                s.name,
-                s.duration,
-                s.method.describe(),
-                s.output_rate,
-                s.mcap_path.display()
-            ),
-            Err(c) => code = c,
-        }
+        let s = match load(p, &Overrides::default()) {
+            Ok(s) => s,
+            Err(c) => {
+                code = c;
+                continue;
+            }
+        };
+        let campaign = if s.montecarlo.is_some() {
+            match crate::montecarlo::load(p, None, None) {
+                Ok(prep) => format!(
+                    "; montecarlo: {} runs, {} dispersions, seed {}",
+                    prep.campaign.runs,
+                    prep.campaign.dispersions.len(),
+                    prep.campaign.seed
+                ),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    code = EXIT_BAD_INPUT;
+                    continue;
+                }
+            }
+        } else {
+            String::new()
+        };
+        println!(
+            "{}: ok ({}; {}; {}; {} Hz to {}{campaign})",
+            p.display(),
+            s.name,
+            crate::timefmt::seconds(s.duration),
+            s.method.describe(),
+            s.output_rate,
+            s.mcap_path.display()
+        );
     }
     code
 }
@@ -956,11 +1007,11 @@ fn run(
         eprintln!("warning: {}", w.message);
     }
     match &outcome.status {
-        Status::Completed | Status::Stopped { .. } => 0,
+        Status::Complete | Status::Stopped { .. } => 0,
         Status::Interrupted => {
             eprintln!(
-                "interrupted at t = {} s: the log holds what was computed and is marked partial",
-                outcome.final_observation.t
+                "interrupted at t = {}: the log holds what was computed and is marked partial",
+                crate::timefmt::seconds(outcome.final_observation.t)
             );
             EXIT_INTERRUPTED
         }
@@ -968,8 +1019,15 @@ fn run(
             eprintln!("error: the integration failed: {diagnosis}");
             EXIT_FAILED
         }
+        Status::InvalidModel { diagnosis } => {
+            eprintln!("error: the model left its validity range: {diagnosis}");
+            EXIT_FAILED
+        }
     }
 }
+
+/// Event lines the text summary prints; the rest are counted.
+const PRINTED_EVENTS: usize = 10;
 
 /// The `--summary` JSON document.
 #[derive(serde::Serialize)]
@@ -1039,14 +1097,10 @@ fn body(s: &Scenario) -> Body {
             Err(_) => (sc.hub.principal_moments, sc.hub.principal_axes),
         }
     };
-    let axis = |c: usize| {
-        let a = axes.column(c);
-        [a[0], a[1], a[2]]
-    };
     let sa = s.spacecraft.spin_axis;
     Body {
         principal_moments: [p[0], p[1], p[2]],
-        principal_axes: [axis(0), axis(1), axis(2)],
+        principal_axes: RigidBody::reported_axes(&axes),
         spin_axis: [sa[0], sa[1], sa[2]],
     }
 }
@@ -1161,7 +1215,7 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
             _ => String::new(),
         }
     );
-    println!("  t = {} s", f.t);
+    println!("  t = {}", crate::timefmt::seconds(f.t));
     println!(
         "  ω = [{:.9e}, {:.9e}, {:.9e}] rad/s",
         f.omega[0], f.omega[1], f.omega[2]
@@ -1218,12 +1272,19 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
             o.stats.newton_iterations, o.stats.jacobian_evaluations, o.stats.factorizations
         );
     }
-    for e in &o.events {
+    for e in o.events.iter().take(PRINTED_EVENTS) {
         println!(
             "  event: t = {:.9} s  {}{}",
             e.t,
             e.condition,
             if e.terminal { " (stop)" } else { "" }
+        );
+    }
+    let more = (o.events.len() - o.events.len().min(PRINTED_EVENTS)) as u64 + o.events_not_kept;
+    if more > 0 {
+        println!(
+            "  … and {more} more events (all are in the log and in --summary; `once: true` or \
+             `for: SECONDS` on a condition records only what answers the question)"
         );
     }
     if let Some(p) = mcap {

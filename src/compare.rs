@@ -89,11 +89,7 @@ fn describe_model(s: &Scenario) -> String {
 /// as events.
 pub fn run_one(mut s: Scenario, interrupt: &AtomicBool) -> std::io::Result<Row> {
     for deg in MILESTONES_DEG {
-        let c = Condition {
-            quantity: Quantity::NutationAngleDeg,
-            threshold: deg,
-            above: true,
-        };
+        let c = Condition::crossing(Quantity::NutationAngleDeg, deg, true);
         if !s.events.contains(&c) {
             s.events.push(c);
         }

@@ -22,3 +22,4 @@ pub mod montecarlo;
 pub mod plot;
 pub mod scenario;
 pub mod sim;
+pub mod timefmt;

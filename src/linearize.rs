@@ -939,6 +939,7 @@ mod tests {
             damping: 0.5,
             initial_rate: 0.0,
             position: Vector3::zeros(),
+            max_speed: None,
         }))
         .unwrap();
         let lin = linearize(&sc, 2.0).unwrap();
@@ -970,6 +971,7 @@ mod tests {
             direction: Vector3::z(),
             stiffness: 0.8,
             damping: 5.0,
+            travel: None,
         };
         sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0])))
             .unwrap();

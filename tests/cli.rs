@@ -478,7 +478,7 @@ fn assert_partial_log_is_valid(path: &Path) {
         n += 1;
     }
     assert!(n > 3, "only {n} messages");
-    assert_eq!(log_status(&bytes), "interrupted (partial)");
+    assert_eq!(log_status(&bytes), "interrupted");
 }
 
 /// An explicit method far above its stability limit: the run stops with a diagnosis (time,
@@ -527,7 +527,7 @@ fn unstable_step_stops_with_a_diagnosis_and_a_partial_log() {
         m.unwrap();
     }
     let s = mcap::Summary::read(&bytes).unwrap().unwrap();
-    assert_eq!(log_status(&bytes), "failed (partial)");
+    assert_eq!(log_status(&bytes), "failed");
     // The last finite state is the log's last sample: /telemetry field 1 is sim_time, a
     // protobuf double (key 0x09, then 8 bytes little-endian).
     let telemetry = s

@@ -277,6 +277,7 @@ fn wheel_damper_nonlinear_decay_matches_the_eigenvalue() {
         damping: 0.5,
         initial_rate: 0.0,
         position: Vector3::zeros(),
+        max_speed: None,
     }))
     .unwrap();
     let nut = linearize(&sc, 2.0).unwrap().nutation.unwrap();
@@ -305,6 +306,7 @@ fn axial_damper_nonlinear_rates_match_the_eigenvalues() {
             direction: Vector3::z(),
             stiffness: 0.8,
             damping: 5.0,
+            travel: None,
         };
         sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0])))
             .unwrap();

@@ -186,7 +186,7 @@ fn triaxial_gyrostat_matches_the_two_by_two() {
 /// energy-sink argument: a damper on a body turning at ω₃ dissipates at the rate λ the
 /// nutation sweeps past it, and the nutation decays when λ > 0). A minor-axis spinner
 /// (composite diag(1000, 1000, 600), ω₃ = 1: λ < 0 without a rotor) with the axial spring–mass
-/// damper of validation.md is unstable; a rotor with h < (I_t − I_s)ω₃ = 400 N m s leaves it
+/// damper of docs/validation.md is unstable; a rotor with h < (I_t − I_s)ω₃ = 400 N m s leaves it
 /// unstable; h > 400 makes it stable. (The damper at x = 1 m sliding along z is driven by
 /// δω̇_y − Ω δω_x = (λ − Ω) δω_x in the nutation mode, so λ = Ω — h = 1400 here — leaves it
 /// undriven and the nutation undamped: avoided.)

@@ -196,7 +196,7 @@ fn gauss_keeps_energy_and_momentum_over_1e5_seconds_of_free_tumbling() {
         );
         s.output_rate = 1e-3;
         let o = run_quietly(&s);
-        assert_eq!(o.status, Status::Completed);
+        assert_eq!(o.status, Status::Complete);
         assert_eq!(o.stats.steps, 200_000);
         eprintln!("gauss-{stages}: {:?}", o.drift);
         assert!(
@@ -309,7 +309,7 @@ fn implicit_methods_stay_bounded_above_the_explicit_bound() {
         let s = parse(STIFF, ov);
         let o = run_quietly(&s);
         eprintln!("{label}: {:?} {:?} {:?}", o.status, o.drift, o.stats);
-        assert_eq!(o.status, Status::Completed, "{label}");
+        assert_eq!(o.status, Status::Complete, "{label}");
         // Passive scene: the energy balance must not grow.
         // (Measured 3e-16 … 3e-11; an unstable method would grow it without bound.)
         assert!(o.drift.energy_rel < 1e-8, "{label}: {:?}", o.drift);

@@ -208,7 +208,7 @@ fn stable(k: f64, m: &MethodSpec, dt: f64) -> bool {
     let mut sink = NullSink;
     match run_into(&s, &mut sink) {
         Ok(o) => {
-            o.status == Status::Completed
+            o.status == Status::Complete
                 && o.final_observation.elastic_energy.is_finite()
                 && o.final_observation.elastic_energy <= o.initial_observation.elastic_energy
         }

@@ -15,7 +15,7 @@
 //! momentum and its energy is a quadratic polynomial in s, which that rule integrates exactly.
 
 use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::Drawing;
+use crate::model::{Drawing, Validity};
 use nalgebra::Vector3;
 
 /// Which joint angles are free.
@@ -83,6 +83,14 @@ impl HingedRod {
     }
 }
 
+/// |cos θ_f| below which a flap–lag rod is at its coordinate singularity: flap within 2.9° of
+/// ±90°, where the rod lies along its lag axis, lag is undefined, and the lag spring and damper
+/// act on a vanishing inertia (the equations become infinitely stiff).
+pub const SINGULAR_COS_FLAP: f64 = 0.05;
+/// Flap angle (degrees from 0, folded into [0°, 90°]) past which a flap–lag rod warns that it
+/// nears the singularity: the lag inertia has fallen to cos² 75° = 7 % of its value at rest.
+pub const FLAP_WARN_DEG: f64 = 75.0;
+
 /// Stations and weights of the 2-point Gauss rule on [0, 1].
 const STATIONS: [f64; 2] = [
     0.5 - 0.288_675_134_594_812_9, // ½ (1 − 1/√3)
@@ -113,6 +121,27 @@ impl ParticleModel for HingedRod {
     }
     fn num_particles(&self) -> usize {
         2
+    }
+    fn validity(&self, q: &[f64]) -> Option<Validity> {
+        (self.freedom == HingeFreedom::FlapLag).then(|| Validity {
+            value: q[0].cos().abs().min(1.0).acos().to_degrees(),
+            warn: FLAP_WARN_DEG,
+            limit: SINGULAR_COS_FLAP.acos().to_degrees(),
+        })
+    }
+    fn validity_report(&self, q: &[f64]) -> (String, String) {
+        (
+            format!(
+                "it has swung to flap = {:.2}°: at ±90° it lies along its lag axis, where the \
+                 flap–lag angles are singular (lag is undefined) and the lag spring and damper \
+                 act on no inertia (warning past {FLAP_WARN_DEG}° of flap, limit {:.2}°)",
+                q[0].to_degrees(),
+                SINGULAR_COS_FLAP.acos().to_degrees()
+            ),
+            "keep the rod away from 90° flap (a stiffer flap spring, a smaller initial flap \
+             rate), or give it one freedom (`freedom: flap` or `lag`)"
+                .into(),
+        )
     }
     fn particle(
         &self,

@@ -18,7 +18,7 @@
 
 use super::beam::BeamModes;
 use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::Drawing;
+use crate::model::{Drawing, Validity};
 use nalgebra::Vector3;
 
 /// A modal cantilever beam.
@@ -91,6 +91,47 @@ impl ModalBeam {
         (0..self.bending.len())
             .map(|d| (0..n).map(|i| q[d * n + i] * tip.phi[i]).sum())
             .collect()
+    }
+}
+
+/// Tip deflection over length at which the small-deflection beam stops being accurate: the
+/// linear tip deflection of a tip-loaded cantilever is 1 % above the inextensible elastica's
+/// at δ/L = 0.1 (Bisshopp & Drucker 1945; docs/effectors.md). Past it the run warns.
+pub const DEFLECTION_WARN: f64 = 0.1;
+/// Tip deflection over length past which the model does not hold: the linear deflection is
+/// 10 % above the elastica's at δ/L = 0.30 (PL²/EI = 1, δ/L = 0.3017 exactly), and the
+/// second-order foreshortening has lost the same order. Past it the run stops.
+pub const DEFLECTION_LIMIT: f64 = 0.3;
+
+impl ModalBeam {
+    /// Beam length L (m): the tip's distance from the root.
+    pub fn length(&self) -> f64 {
+        self.modes.nodes[self.modes.tip].x
+    }
+
+    /// Axial foreshortening of the tip s(L) (m), as the second-order kinematics has it.
+    pub fn tip_foreshortening(&self, q: &[f64]) -> f64 {
+        let n = self.n_modes();
+        let tip = &self.modes.nodes[self.modes.tip];
+        (0..self.bending.len())
+            .map(|d| {
+                let qd = &q[d * n..(d + 1) * n];
+                0.5 * quadratic(&tip.shortening, qd, qd, n)
+            })
+            .sum()
+    }
+
+    /// Tip deflection off the beam's axis, all bending directions together (m).
+    fn tip_offset(&self, q: &[f64]) -> f64 {
+        let n = self.n_modes();
+        let tip = &self.modes.nodes[self.modes.tip];
+        (0..self.bending.len())
+            .map(|d| {
+                let w: f64 = (0..n).map(|i| q[d * n + i] * tip.phi[i]).sum();
+                w * w
+            })
+            .sum::<f64>()
+            .sqrt()
     }
 }
 
@@ -179,6 +220,31 @@ impl ParticleModel for ModalBeam {
     }
     fn extra_telemetry(&self, q: &[f64]) -> Vec<f64> {
         self.tip_deflection(q)
+    }
+    fn validity(&self, q: &[f64]) -> Option<Validity> {
+        Some(Validity {
+            value: self.tip_offset(q) / self.length(),
+            warn: DEFLECTION_WARN,
+            limit: DEFLECTION_LIMIT,
+        })
+    }
+    fn validity_report(&self, q: &[f64]) -> (String, String) {
+        let length = self.length();
+        let offset = self.tip_offset(q);
+        (
+            format!(
+                "its tip is {offset:.4} m off the beam's axis, δ/L = {:.3} of its {length} m \
+                 length (foreshortened by {:.4} m); the small-deflection modal model is \
+                 accurate to δ/L = {DEFLECTION_WARN} (1% error) and does not hold past \
+                 δ/L = {DEFLECTION_LIMIT} (10%)",
+                offset / length,
+                self.tip_foreshortening(q)
+            ),
+            "a stiffer boom (bending_stiffness) or more damping to keep the deflection small, \
+             or rigid `hinged_rod` links for large motion; more modes help only if the shape \
+             is not the first mode's"
+                .into(),
+        )
     }
     fn drawings(&self, q: &[f64]) -> Vec<Drawing> {
         // About a dozen vertices along the beam, root and tip included.

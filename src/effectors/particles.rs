@@ -24,7 +24,7 @@
 //! exactly by the continuous equations (tested), whatever the kinematics.
 
 use crate::model::{
-    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
+    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum, Validity,
 };
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
@@ -98,6 +98,14 @@ pub trait ParticleModel: Debug + Send + Sync {
     }
     /// What the 3D view draws at `q`.
     fn drawings(&self, q: &[f64]) -> Vec<Drawing>;
+    /// Where coordinates `q` stand against the model's range ([`Effector::validity`]).
+    fn validity(&self, _q: &[f64]) -> Option<Validity> {
+        None
+    }
+    /// The validity measure at `q` in words ([`Effector::validity_report`]).
+    fn validity_report(&self, _q: &[f64]) -> (String, String) {
+        (String::new(), String::new())
+    }
 }
 
 /// A [`ParticleModel`] as an effector: states `[q (n), u (n), dissipated energy]`.
@@ -395,6 +403,15 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
 
     fn drawings(&self, x: &[f64]) -> Vec<Drawing> {
         self.model.drawings(&x[..self.model.num_coordinates()])
+    }
+
+    fn validity(&self, x: &[f64]) -> Option<Validity> {
+        self.model.validity(&x[..self.model.num_coordinates()])
+    }
+
+    fn validity_report(&self, x: &[f64]) -> (String, String) {
+        self.model
+            .validity_report(&x[..self.model.num_coordinates()])
     }
 }
 

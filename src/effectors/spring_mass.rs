@@ -6,7 +6,7 @@
 //! couple correctly through the hub.
 
 use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::Drawing;
+use crate::model::{Drawing, Validity};
 use nalgebra::Vector3;
 
 /// A spring–mass–dashpot damper.
@@ -22,7 +22,13 @@ pub struct SpringMass {
     pub stiffness: f64,
     /// Dashpot coefficient c (N s/m).
     pub damping: f64,
+    /// Travel |ρ| the damper's stops allow (m); `None` for an unlimited line. Past it the
+    /// particle would hit its stop, which the model does not have.
+    pub travel: Option<f64>,
 }
+
+/// Fraction of the travel past which the damper warns that it nears its stop.
+pub const TRAVEL_WARN: f64 = 0.9;
 
 impl ParticleModel for SpringMass {
     type Cache = ();
@@ -52,6 +58,26 @@ impl ParticleModel for SpringMass {
     }
     fn dissipation_power(&self, _q: &[f64], u: &[f64]) -> f64 {
         self.damping * u[0] * u[0]
+    }
+    fn validity(&self, q: &[f64]) -> Option<Validity> {
+        self.travel.map(|travel| Validity {
+            value: q[0].abs(),
+            warn: TRAVEL_WARN * travel,
+            limit: travel,
+        })
+    }
+    fn validity_report(&self, q: &[f64]) -> (String, String) {
+        (
+            format!(
+                "its mass is {:.4} m from its rest point, against a travel of {} m (warning at \
+                 {}%); the model has no end stops, so past the travel it is no longer the \
+                 damper built",
+                q[0].abs(),
+                self.travel.unwrap_or(f64::INFINITY),
+                TRAVEL_WARN * 100.0
+            ),
+            "a stiffer spring, more travel, or a smaller disturbance".into(),
+        )
     }
     fn drawings(&self, q: &[f64]) -> Vec<Drawing> {
         let size = (self.mass.cbrt() * 0.05).clamp(0.02, 0.3);

@@ -45,6 +45,7 @@ fn roithmayr_damper(hub_mass: f64, particle_mass: f64) -> Spacecraft {
         direction: Vector3::z(),
         stiffness: 52.744,
         damping: 105.49,
+        travel: None,
     };
     sc.add_effector(Box::new(ParticleEffector::new(
         "damper",
@@ -88,6 +89,7 @@ fn several_dampers_and_a_wheel_conserve_momentum_together() {
             direction: dir,
             stiffness: 3.0,
             damping: 0.7,
+            travel: None,
         };
         sc.add_effector(Box::new(ParticleEffector::new(
             format!("d{i}"),
@@ -104,6 +106,7 @@ fn several_dampers_and_a_wheel_conserve_momentum_together() {
         damping: 0.2,
         initial_rate: 1.5,
         position: Vector3::zeros(),
+        max_speed: None,
     }))
     .unwrap();
     let y0 = sc.initial_state(&Vector3::new(0.2, -0.1, 1.0), &UnitQuaternion::identity());
@@ -133,6 +136,7 @@ fn one_damper_depends_on_the_masses_only_through_the_reduced_mass() {
             direction: Vector3::z(),
             stiffness: 0.8,
             damping: 5.0,
+            travel: None,
         };
         sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.02], &[0.0])))
             .unwrap();

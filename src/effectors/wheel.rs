@@ -11,7 +11,7 @@
 //! States: Ω (rad/s) and the dissipated energy (Ẇ = D Ω²).
 
 use crate::model::{
-    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
+    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum, Validity,
 };
 use nalgebra::Vector3;
 
@@ -30,7 +30,12 @@ pub struct WheelDamper {
     pub initial_rate: f64,
     /// Where to draw it (m, body axes).
     pub position: Vector3<f64>,
+    /// Largest relative rotor speed |Ω| the wheel is rated for (rad/s); `None`: unrated.
+    pub max_speed: Option<f64>,
 }
+
+/// Fraction of the rated speed past which the wheel warns.
+pub const SPEED_WARN: f64 = 0.9;
 
 impl Effector for WheelDamper {
     fn name(&self) -> &str {
@@ -92,6 +97,27 @@ impl Effector for WheelDamper {
     }
     fn telemetry(&self, _hub: &HubState, x: &[f64]) -> Vec<f64> {
         vec![x[0], x[1], self.damping * x[0] * x[0]]
+    }
+    fn validity(&self, x: &[f64]) -> Option<Validity> {
+        self.max_speed.map(|max| Validity {
+            value: x[0].abs(),
+            warn: SPEED_WARN * max,
+            limit: max,
+        })
+    }
+    fn validity_report(&self, x: &[f64]) -> (String, String) {
+        (
+            format!(
+                "its rotor turns at {:.6e} rad/s relative to the hub, against its rated {} \
+                 rad/s (warning at {}%)",
+                x[0].abs(),
+                self.max_speed.unwrap_or(f64::INFINITY),
+                SPEED_WARN * 100.0
+            ),
+            "a rotor with more inertia or less initial rate, or a higher rating if the \
+             hardware has it"
+                .into(),
+        )
     }
     fn drawings(&self, _x: &[f64]) -> Vec<Drawing> {
         let d = (self.inertia.sqrt() * 0.5).clamp(0.05, 0.5);

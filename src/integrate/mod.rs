@@ -87,21 +87,28 @@ impl fmt::Display for StepError {
         match self {
             StepError::StepSizeUnderflow { t, h } => write!(
                 f,
-                "step size underflow at t = {t} s (h = {h:e} s): the tolerance cannot be met; \
-                 loosen rtol/atol or check the model for a singularity"
+                "step size underflow at t = {} (h = {h:e} s): the tolerance cannot be met; \
+                 loosen rtol/atol or check the model for a singularity",
+                crate::timefmt::seconds(*t)
             ),
             StepError::NonFiniteDerivative { t } => write!(
                 f,
-                "the right-hand side became non-finite at t = {t} s: the state left the domain \
-                 of the model"
+                "the right-hand side became non-finite at t = {}: the state left the domain \
+                 of the model",
+                crate::timefmt::seconds(*t)
             ),
             StepError::NewtonFailure { t, h } => write!(
                 f,
-                "the Newton iteration of the implicit method did not converge at t = {t} s \
-                 (h = {h:e} s): reduce the step, or check the model for a singularity"
+                "the Newton iteration of the implicit method did not converge at t = {} \
+                 (h = {h:e} s): reduce the step, or check the model for a singularity",
+                crate::timefmt::seconds(*t)
             ),
             StepError::SubFlow { t, what } => {
-                write!(f, "a sub-flow failed in the step from t = {t} s: {what}")
+                write!(
+                    f,
+                    "a sub-flow failed in the step from t = {}: {what}",
+                    crate::timefmt::seconds(*t)
+                )
             }
         }
     }

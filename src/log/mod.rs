@@ -437,6 +437,7 @@ impl<'a> McapLogger<'a> {
                 .into(),
         );
         meta.insert("status".into(), outcome.status.label().into());
+        meta.insert("partial".into(), outcome.status.is_partial().to_string());
         meta.insert("sim_time_end".into(), format!("{t_end}"));
         meta.insert("steps".into(), outcome.stats.steps.to_string());
         meta.insert(
@@ -455,21 +456,34 @@ impl<'a> McapLogger<'a> {
     pub fn end_run(&mut self, outcome: &Outcome) -> io::Result<()> {
         let t_end = outcome.final_observation.t;
         let level = match outcome.status {
-            crate::sim::Status::Completed | crate::sim::Status::Stopped { .. } => {
+            crate::sim::Status::Complete | crate::sim::Status::Stopped { .. } => {
                 fg::log::Level::Info
             }
             _ => fg::log::Level::Warning,
         };
         let text = match &outcome.status {
-            crate::sim::Status::Completed => format!("run complete at t = {t_end} s"),
+            crate::sim::Status::Complete => {
+                format!("run complete at t = {}", crate::timefmt::seconds(t_end))
+            }
             crate::sim::Status::Stopped { condition } => {
-                format!("run stopped at t = {t_end} s: {condition}")
+                format!(
+                    "run stopped at t = {}: {condition}",
+                    crate::timefmt::seconds(t_end)
+                )
             }
             crate::sim::Status::Interrupted => {
-                format!("run interrupted at t = {t_end} s; this log is partial")
+                format!(
+                    "run interrupted at t = {}; this log is partial",
+                    crate::timefmt::seconds(t_end)
+                )
             }
             crate::sim::Status::Failed { diagnosis } => {
                 format!("run failed; this log is partial: {diagnosis}")
+            }
+            crate::sim::Status::InvalidModel { diagnosis } => {
+                format!(
+                    "run stopped outside the model's validity; this log is partial: {diagnosis}"
+                )
             }
         };
         self.log_text(t_end, level, &text)
@@ -813,13 +827,15 @@ impl Sink for McapLogger<'_> {
     }
 
     fn event(&mut self, e: &EventRecord, o: &Observation) -> io::Result<()> {
+        // Logged when known: with `for:`, at the end of the interval that held.
         let text = format!(
-            "event at t = {:.9} s: {} (nutation {:.4}°)",
-            e.t,
+            "event at t = {}: {} (nutation {:.4}° at t = {})",
+            crate::timefmt::seconds(e.t),
             e.condition,
-            o.nutation_angle.to_degrees()
+            o.nutation_angle.to_degrees(),
+            crate::timefmt::seconds(o.t)
         );
-        self.log_text(e.t, fg::log::Level::Info, &text)
+        self.log_text(e.confirmed, fg::log::Level::Info, &text)
     }
 
     fn warning(&mut self, w: &crate::sim::Warning) -> io::Result<()> {

@@ -127,6 +127,21 @@ impl RigidBody {
         })
     }
 
+    /// The principal axes as reported (docs/conventions.md): unit vectors in body axes, in
+    /// the order of the moments, each pointing into the positive half of the body axis it is
+    /// closest to. Unlike [`RigidBody::principal_axes`], which is a rotation (right-handed),
+    /// the listed triad is left-handed when the ascending order of the moments is an odd
+    /// permutation of x, y, z (e.g. I_z < I_y < I_x).
+    pub fn reported_axes(axes: &Matrix3<f64>) -> [[f64; 3]; 3] {
+        std::array::from_fn(|c| {
+            let col = axes.column(c);
+            let (imax, _) = col.iamax_full();
+            let sign = if col[imax] < 0.0 { -1.0 } else { 1.0 };
+            // `+ 0.0` turns −0 into 0, so no axis prints as `-0.000`.
+            std::array::from_fn(|r| sign * col[r] + 0.0)
+        })
+    }
+
     /// A body with principal moments `[i1, i2, i3]` (kg m²) along the body x, y, z axes.
     pub fn from_principal(moments: [f64; 3]) -> Result<Self, InertiaError> {
         Self::new(Matrix3::from_diagonal(&Vector3::from(moments)))
@@ -154,6 +169,28 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use nalgebra::{Rotation3, Unit};
+
+    #[test]
+    fn reported_axes_point_into_the_positive_half_whatever_the_order() {
+        // A 3U CubeSat lying along x: I_z < I_y < I_x, an odd permutation of x, y, z, so the
+        // right-handed rotation must flip one axis; the reported directions do not.
+        let body = RigidBody::from_principal([0.035, 0.033, 0.008]).unwrap();
+        let rotation = body.principal_axes;
+        assert_relative_eq!(rotation.determinant(), 1.0, epsilon = 1e-12);
+        let reported = RigidBody::reported_axes(&rotation);
+        assert_eq!(
+            reported,
+            [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+        );
+        assert!(reported.iter().flatten().all(|v| v.is_sign_positive()));
+        // An even permutation (x, y, z ascending) is right-handed as reported.
+        let body = RigidBody::from_principal([1.0, 2.0, 3.0]).unwrap();
+        let reported = RigidBody::reported_axes(&body.principal_axes);
+        assert_eq!(
+            reported,
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+        );
+    }
 
     #[test]
     fn principal_axes_of_a_rotated_tensor() {

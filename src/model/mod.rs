@@ -146,6 +146,32 @@ pub enum Drawing {
     },
 }
 
+/// Where an effector's state stands against the range in which its model holds.
+///
+/// The measure's unit is the effector's own (a deflection ratio, an angle, a speed); the run
+/// warns once past `warn` and stops with a diagnosis past `limit` (`checks.on_validity`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Validity {
+    /// The measure at the present state.
+    pub value: f64,
+    /// Past this the model's error is no longer negligible: warn once.
+    pub warn: f64,
+    /// Past this the model does not hold.
+    pub limit: f64,
+}
+
+impl Validity {
+    /// Whether the measure is past the warning threshold.
+    pub fn past_warning(&self) -> bool {
+        self.value > self.warn
+    }
+
+    /// Whether the measure is past the limit.
+    pub fn past_limit(&self) -> bool {
+        self.value > self.limit
+    }
+}
+
 /// A part of the spacecraft with its own states and couplings (dampers, appendages, torques).
 ///
 /// State layout: `num_dynamic_states()` dynamic states first, then bookkeeping states (such as
@@ -209,6 +235,16 @@ pub trait Effector: Debug + Send + Sync {
     /// What the 3D view draws for it at states `x`.
     fn drawings(&self, _x: &[f64]) -> Vec<Drawing> {
         Vec::new()
+    }
+    /// Where its states `x` stand against the range its model holds in; `None` for a model
+    /// without one. Checked after every accepted step, so it must be cheap.
+    fn validity(&self, _x: &[f64]) -> Option<Validity> {
+        None
+    }
+    /// The validity measure at `x` in words, with its value and limits, and what to do
+    /// beyond them: `(where it stands, remedy)`, for warnings and diagnoses.
+    fn validity_report(&self, _x: &[f64]) -> (String, String) {
+        (String::new(), String::new())
     }
 }
 

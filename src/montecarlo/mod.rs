@@ -362,10 +362,11 @@ impl Prepared {
             }
         };
         let (status, message) = match &outcome.status {
-            Status::Completed => (RunStatus::Complete, String::new()),
+            Status::Complete => (RunStatus::Complete, String::new()),
             Status::Stopped { condition } => (RunStatus::Stopped, condition.clone()),
             Status::Interrupted => return None,
             Status::Failed { diagnosis } => (RunStatus::Failed, diagnosis.clone()),
+            Status::InvalidModel { diagnosis } => (RunStatus::InvalidModel, diagnosis.clone()),
         };
         for (k, c) in self.event_conditions.iter().enumerate() {
             values[self.event_start + k] = outcome

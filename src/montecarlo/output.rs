@@ -262,13 +262,23 @@ fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
     let s = &d.status;
     let _ = writeln!(
         out,
-        "runs: {} complete, {} stopped, {} failed, {} invalid",
-        s.complete, s.stopped, s.failed, s.invalid
+        "runs: {} complete, {} stopped, {} failed, {} invalid, {} invalid_model",
+        s.complete, s.stopped, s.failed, s.invalid, s.invalid_model
     );
     for e in &d.events {
+        let excluded = if e.excluded == 0 {
+            String::new()
+        } else {
+            format!(
+                "; {} runs excluded ({} invalid_model, {} failed or invalid)",
+                e.excluded,
+                e.excluded_invalid_model,
+                e.excluded - e.excluded_invalid_model
+            )
+        };
         let _ = writeln!(
             out,
-            "\nevent `{}`: reached in {} of {} usable runs",
+            "\nevent `{}`: reached in {} of {} usable runs{excluded}",
             e.condition, e.reached, e.runs
         );
         for b in &e.by {

@@ -47,8 +47,13 @@ pub struct EventStats {
     pub condition: String,
     /// Its time column.
     pub column: String,
-    /// Usable runs (complete or stopped).
+    /// Usable runs (complete or stopped): the denominator of the probabilities.
     pub runs: usize,
+    /// Runs left out of the probabilities: failed, invalid draws, and runs whose model left
+    /// its validity range (`invalid_model`).
+    pub excluded: usize,
+    /// Of those, the runs stopped as `invalid_model`.
+    pub excluded_invalid_model: usize,
     /// Runs in which it happened at all.
     pub reached: usize,
     /// Probabilities by the requested times.
@@ -75,7 +80,7 @@ pub struct Ranking {
 pub struct Failure {
     /// Run index.
     pub run: u64,
-    /// `failed` or `invalid`.
+    /// `failed`, `invalid` or `invalid_model`.
     pub status: &'static str,
     /// Diagnosis.
     pub message: String,
@@ -92,6 +97,8 @@ pub struct StatusCounts {
     pub failed: usize,
     /// Draw could not be made a valid scenario.
     pub invalid: usize,
+    /// An effector left the range its model holds in.
+    pub invalid_model: usize,
 }
 
 /// Up to this many failures are listed in the summary (all are in the table).
@@ -119,6 +126,7 @@ pub fn status_counts(rows: &[Row]) -> StatusCounts {
             RunStatus::Stopped => c.stopped += 1,
             RunStatus::Failed => c.failed += 1,
             RunStatus::Invalid => c.invalid += 1,
+            RunStatus::InvalidModel => c.invalid_model += 1,
         }
     }
     c
@@ -189,6 +197,11 @@ pub fn event_stats(condition: &str, name: &str, j: usize, rows: &[Row], by: &[f6
         condition: condition.to_string(),
         column: name.to_string(),
         runs: n,
+        excluded: rows.len() - n,
+        excluded_invalid_model: rows
+            .iter()
+            .filter(|r| r.status == RunStatus::InvalidModel)
+            .count(),
         reached: times.len(),
         by: by
             .iter()

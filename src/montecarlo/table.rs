@@ -21,6 +21,9 @@ pub enum RunStatus {
     Failed,
     /// The draw could not be made into a valid scenario (reason in the message).
     Invalid,
+    /// An effector left the range its model holds in (`checks.on_validity: stop`; diagnosis
+    /// in the message).
+    InvalidModel,
 }
 
 impl RunStatus {
@@ -31,14 +34,21 @@ impl RunStatus {
             RunStatus::Stopped => "stopped",
             RunStatus::Failed => "failed",
             RunStatus::Invalid => "invalid",
+            RunStatus::InvalidModel => "invalid_model",
         }
     }
 
     /// Parses [`RunStatus::label`].
     pub fn parse(s: &str) -> Option<Self> {
-        [Self::Complete, Self::Stopped, Self::Failed, Self::Invalid]
-            .into_iter()
-            .find(|v| v.label() == s)
+        [
+            Self::Complete,
+            Self::Stopped,
+            Self::Failed,
+            Self::Invalid,
+            Self::InvalidModel,
+        ]
+        .into_iter()
+        .find(|v| v.label() == s)
     }
 
     /// Whether the run's metrics are usable (complete or stopped).

@@ -87,6 +87,9 @@ pub struct SpringMassSpec {
     /// Initial rate (m/s).
     #[serde(default)]
     pub initial_rate: Option<Spanned<f64>>,
+    /// Travel |offset| the damper's stops allow (m); beyond it the model does not hold.
+    #[serde(default)]
+    pub travel: Option<Spanned<f64>>,
 }
 
 /// `wheel_damper:`.
@@ -108,6 +111,9 @@ pub struct WheelSpec {
     /// Where to draw it (m, body axes).
     #[serde(default)]
     pub position: Option<Spanned<[f64; 3]>>,
+    /// Largest relative rotor speed the wheel is rated for (rad/s).
+    #[serde(default)]
+    pub max_speed: Option<Spanned<f64>>,
 }
 
 /// A scalar applied to both hinge angles, or `[flap, lag]`.
@@ -506,6 +512,11 @@ pub(super) fn build(
                     direction: ck.unit(&s.direction, "direction")?,
                     stiffness: ck.non_negative(&s.stiffness, "stiffness", "N/m")?,
                     damping: ck.non_negative(&s.damping, "damping", "N s/m")?,
+                    travel: s
+                        .travel
+                        .as_ref()
+                        .map(|t| ck.positive(t, "travel", "m"))
+                        .transpose()?,
                 };
                 let q0 = ck.finite(&s.initial_offset, "initial_offset", "m")?;
                 let u0 = ck.finite(&s.initial_rate, "initial_rate", "m/s")?;
@@ -527,6 +538,11 @@ pub(super) fn build(
                         Some(p) => ck.point(p, "position")?,
                         None => Vector3::zeros(),
                     },
+                    max_speed: w
+                        .max_speed
+                        .as_ref()
+                        .map(|v| ck.positive(v, "max_speed", "rad/s"))
+                        .transpose()?,
                 }));
                 // The rotor is part of the body's inertia: I − I_W â âᵀ must stay positive
                 // definite, i.e. I_W âᵀ I⁻¹ â < 1 (stricter than I_W < âᵀ I â off the

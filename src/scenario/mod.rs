@@ -103,6 +103,10 @@ pub struct ChecksSpec {
     /// `stop` (default: end the run, keep the log, exit 3) or `warn` (note it and go on).
     #[serde(default)]
     pub on_drift: Option<Spanned<String>>,
+    /// When an effector leaves the range its model holds in: `stop` (default: end the run
+    /// as `invalid_model` with a diagnosis) or `warn` (note it once and go on).
+    #[serde(default)]
+    pub on_validity: Option<Spanned<String>>,
 }
 
 /// `checks.max_drift:` bounds (dimensionless, relative to the initial value).
@@ -120,10 +124,11 @@ pub struct DriftBoundsSpec {
     pub quaternion_norm: Option<Spanned<f64>>,
 }
 
-/// What the run does when an invariant drifts beyond its bound.
+/// What the run does when a check fails: an invariant drifts beyond its bound, or an
+/// effector leaves the range its model holds in.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum OnDrift {
+pub enum OnBreach {
     /// End the run as failed (the log up to there is kept, marked partial).
     #[default]
     Stop,
@@ -140,8 +145,10 @@ pub struct DriftLimits {
     pub energy: Option<f64>,
     /// Bound on ||q| − 1|.
     pub quaternion_norm: Option<f64>,
-    /// Stop or warn.
-    pub on_drift: OnDrift,
+    /// Stop or warn on drift.
+    pub on_drift: OnBreach,
+    /// Stop or warn when a model leaves its validity range.
+    pub on_validity: OnBreach,
 }
 
 /// `body:` mass properties and display.
@@ -304,7 +311,8 @@ pub enum ConditionSpec {
     KineticEnergy(ThresholdSpec),
 }
 
-/// `{above: X}` or `{below: X}`: the condition holds while the quantity is above (below) X.
+/// `{above: X}` or `{below: X}`: the condition holds while the quantity is above (below) X;
+/// `once: true` records only its first occurrence, `for: S` asks that it hold S seconds.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ThresholdSpec {
@@ -314,6 +322,13 @@ pub struct ThresholdSpec {
     /// Holds while the quantity is less than this.
     #[serde(default)]
     pub below: Option<f64>,
+    /// Record only the first time the condition becomes true (default false).
+    #[serde(default)]
+    pub once: Option<bool>,
+    /// The condition must hold continuously this long (s) before it counts; the event's
+    /// time is the start of the interval that held (default 0: at once).
+    #[serde(default, rename = "for")]
+    pub hold: Option<f64>,
 }
 
 /// A quantity events can watch.
@@ -364,6 +379,10 @@ pub struct Condition {
     pub threshold: f64,
     /// `true` for `above`, `false` for `below`.
     pub above: bool,
+    /// Only the first occurrence is recorded.
+    pub once: bool,
+    /// How long the condition must hold before it counts (s); 0 counts at once.
+    pub hold: f64,
 }
 
 impl Condition {
@@ -373,10 +392,29 @@ impl Condition {
         if self.above { d } else { -d }
     }
 
-    /// Human-readable form, e.g. `nutation_angle_deg above 89`.
+    /// A condition that holds at once, recorded every time it becomes true.
+    pub fn crossing(quantity: Quantity, threshold: f64, above: bool) -> Self {
+        Condition {
+            quantity,
+            threshold,
+            above,
+            once: false,
+            hold: 0.0,
+        }
+    }
+
+    /// Human-readable form, e.g. `nutation_angle_deg above 89`, `nutation_angle_deg below 1
+    /// for 60 s`, `omega_z above 2 once`. Also the key of a campaign's event column.
     pub fn describe(&self) -> String {
         let dir = if self.above { "above" } else { "below" };
-        format!("{} {dir} {}", self.quantity.key(), self.threshold)
+        let mut text = format!("{} {dir} {}", self.quantity.key(), self.threshold);
+        if self.hold > 0.0 {
+            text += &format!(" for {} s", self.hold);
+        }
+        if self.once {
+            text += " once";
+        }
+        text
     }
 }
 
@@ -770,7 +808,14 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
         let last = field.rsplit('.').next().unwrap_or("");
         let text_field = matches!(
             last,
-            "name" | "description" | "epoch" | "mcap" | "method" | "on_drift" | "freedom"
+            "name"
+                | "description"
+                | "epoch"
+                | "mcap"
+                | "method"
+                | "on_drift"
+                | "on_validity"
+                | "freedom"
         );
         let what = location
             .and_then(|(l, c)| {
@@ -936,19 +981,19 @@ fn drift_limits(
     let Some(checks) = checks else {
         return Ok(DriftLimits::default());
     };
-    let on_drift = match &checks.on_drift {
-        None => OnDrift::Stop,
-        Some(a) if a.value == "stop" => OnDrift::Stop,
-        Some(a) if a.value == "warn" => OnDrift::Warn,
-        Some(a) => {
-            return Err(ScenarioError::at(
-                path,
-                loc(a),
-                "checks.on_drift",
-                format!("expected `stop` or `warn`, got `{}`", a.value),
-            ));
-        }
+    let on_breach = |choice: &Option<Spanned<String>>, key: &str| match choice {
+        None => Ok(OnBreach::Stop),
+        Some(a) if a.value == "stop" => Ok(OnBreach::Stop),
+        Some(a) if a.value == "warn" => Ok(OnBreach::Warn),
+        Some(a) => Err(ScenarioError::at(
+            path,
+            loc(a),
+            format!("checks.{key}"),
+            format!("expected `stop` or `warn`, got `{}`", a.value),
+        )),
     };
+    let on_drift = on_breach(&checks.on_drift, "on_drift")?;
+    let on_validity = on_breach(&checks.on_validity, "on_validity")?;
     let bounds = checks.max_drift.unwrap_or_default();
     let bound = |b: &Option<Spanned<f64>>, key: &str, conserved: bool, why: &str| match b {
         None => Ok(None),
@@ -984,6 +1029,7 @@ fn drift_limits(
         )?,
         quaternion_norm: bound(&bounds.quaternion_norm, "quaternion_norm", true, "")?,
         on_drift,
+        on_validity,
     })
 }
 
@@ -1826,10 +1872,24 @@ fn conditions(
                     "expected a finite threshold",
                 ));
             }
+            let hold = th.hold.unwrap_or(0.0);
+            if !(hold.is_finite() && hold >= 0.0) {
+                return Err(ScenarioError::at(
+                    path,
+                    loc(s),
+                    format!("{field}.for"),
+                    format!(
+                        "expected a duration ≥ 0 s for which the condition must hold, got {}",
+                        number(hold)
+                    ),
+                ));
+            }
             Ok(Condition {
                 quantity,
                 threshold,
                 above,
+                once: th.once.unwrap_or(false),
+                hold,
             })
         })
         .collect()

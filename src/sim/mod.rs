@@ -5,56 +5,87 @@
 //! sign changes of `Condition::margin`, bracketed at step ends (and at interior points) and
 //! located by the Illinois variant of regula falsi on the dense output.
 
+mod events;
 mod methods;
 
 pub use methods::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
 
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
-use crate::scenario::{Condition, DriftLimits, Method, OnDrift, Scenario};
+use crate::scenario::{Condition, DriftLimits, Method, OnBreach, Scenario};
+use crate::timefmt::seconds;
+use events::Watch;
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// A recorded event: a condition became true.
+/// A recorded event: a condition became true (and, with `for:`, held long enough).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct EventRecord {
-    /// Sim time at which the condition became true (s).
+    /// Sim time at which the condition became true (s): with `for:`, the start of the
+    /// interval that held.
     pub t: f64,
+    /// Sim time at which the event was known (s): `t` plus the `for:` duration.
+    #[serde(skip)]
+    pub confirmed: f64,
     /// The condition, e.g. `nutation_angle_deg above 89`.
     pub condition: String,
     /// Whether it ended the run.
     pub terminal: bool,
 }
 
-/// How a run ended.
+/// How a run ended. The serialized `kind` and [`Status::label`] are the one word every
+/// output uses (summary JSON, text, campaign tables, MCAP metadata).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Status {
     /// Reached the scenario's duration.
-    Completed,
+    Complete,
     /// A stop condition became true.
     Stopped {
         /// The condition.
         condition: String,
     },
-    /// Interrupted by the user (Ctrl-C); what was computed is kept.
+    /// Interrupted by the user (Ctrl-C); what was computed is kept, marked partial.
     Interrupted,
-    /// The integration could not continue; what was computed is kept.
+    /// The integration could not continue; what was computed is kept, marked partial.
     Failed {
         /// Diagnosis: what happened, where, and what to try.
+        diagnosis: String,
+    },
+    /// An effector left the range its model holds in (`checks.on_validity: stop`); what was
+    /// computed up to there is kept, marked partial.
+    InvalidModel {
+        /// Diagnosis: which effector, how far out, and what to do.
         diagnosis: String,
     },
 }
 
 impl Status {
-    /// A one-word label for metadata.
+    /// The one-word status.
     pub fn label(&self) -> &'static str {
         match self {
-            Status::Completed => "complete",
+            Status::Complete => "complete",
             Status::Stopped { .. } => "stopped",
-            Status::Interrupted => "interrupted (partial)",
-            Status::Failed { .. } => "failed (partial)",
+            Status::Interrupted => "interrupted",
+            Status::Failed { .. } => "failed",
+            Status::InvalidModel { .. } => "invalid_model",
+        }
+    }
+
+    /// Whether the run ended before its duration or a stop condition (the log is partial).
+    pub fn is_partial(&self) -> bool {
+        matches!(
+            self,
+            Status::Interrupted | Status::Failed { .. } | Status::InvalidModel { .. }
+        )
+    }
+
+    /// The diagnosis of a failed or invalid-model run.
+    pub fn diagnosis(&self) -> Option<&str> {
+        match self {
+            Status::Failed { diagnosis } | Status::InvalidModel { diagnosis } => Some(diagnosis),
+            _ => None,
         }
     }
 }
@@ -259,9 +290,9 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
             .map_err(|e| diagnose(&e.to_string(), t0, stepper.y(), scenario))?;
         if !stepper.y().iter().all(|v| v.is_finite()) {
             let what = format!(
-                "the state became non-finite in the step from t = {} s to t = {} s",
-                stepper.t_prev(),
-                stepper.t()
+                "the state became non-finite in the step from t = {} to t = {}",
+                seconds(stepper.t_prev()),
+                seconds(stepper.t())
             );
             // Without dense output only the step's ends can be read: report the start.
             let mut buf = vec![0.0; y0.len()];
@@ -324,12 +355,22 @@ fn drive<M: Stepper>(
     let limits = scenario.drift_limits;
     let mut window = (0u64, 0.0f64);
     let mut collapsed_windows = 0u32;
-    let conditions: Vec<(&Condition, bool)> = scenario
+    let mut watches: Vec<Watch> = scenario
         .stop
         .iter()
-        .map(|c| (c, true))
-        .chain(scenario.events.iter().map(|c| (c, false)))
+        .map(|c| Watch::new(c, true))
+        .chain(scenario.events.iter().map(|c| Watch::new(c, false)))
         .collect();
+    // Effectors whose models have a validity range, and how far each has been reported
+    // (0: not yet, 1: warned, 2: warned past the limit).
+    let ranged: Vec<usize> = (0..sc.effectors().len())
+        .filter(|&k| {
+            sc.effectors()[k]
+                .validity(sc.effector_states(k, stepper.y()))
+                .is_some()
+        })
+        .collect();
+    let mut validity_reported = vec![0u8; sc.effectors().len()];
 
     buf.copy_from_slice(stepper.y());
     sink.sample(&o0, stepper.y(), &inv)?;
@@ -337,23 +378,38 @@ fn drive<M: Stepper>(
     let mut next_k = 1u64;
     let mut last_sample_t = 0.0;
 
-    // Conditions already true at t = 0 fire at once.
+    // Conditions already true at t = 0 start holding there (and fire, without `for:`).
     let mut status = None;
-    for (c, terminal) in &conditions {
-        if c.margin(&o0) > 0.0 {
+    for w in watches.iter_mut() {
+        if w.start(w.condition.margin(&o0)).is_some() {
             let e = EventRecord {
                 t: 0.0,
-                condition: c.describe(),
-                terminal: *terminal,
+                confirmed: 0.0,
+                condition: w.condition.describe(),
+                terminal: w.terminal,
             };
             sink.event(&e, &o0)?;
             keep_event(&mut events, &mut events_not_kept, e);
-            if *terminal && status.is_none() {
+            if w.terminal && status.is_none() {
                 status = Some(Status::Stopped {
-                    condition: c.describe(),
+                    condition: w.condition.describe(),
                 });
             }
         }
+    }
+    // A model already outside its range at t = 0.
+    if status.is_none()
+        && let Some(s) = check_validity(
+            scenario,
+            &ranged,
+            &mut validity_reported,
+            0.0,
+            stepper.y(),
+            sink,
+            &mut warnings,
+        )?
+    {
+        status = Some(s);
     }
 
     let mut prev = o0.clone();
@@ -391,7 +447,9 @@ fn drive<M: Stepper>(
             let t_good = stepper.t_prev();
             stepper.interpolate(t_good, &mut buf);
             let what = format!(
-                "the state became non-finite in the step from t = {t_good} s to t = {t1} s"
+                "the state became non-finite in the step from t = {} to t = {}",
+                seconds(t_good),
+                seconds(t1)
             );
             status = Some(Status::Failed {
                 diagnosis: diagnose(&what, t_good, &buf, scenario),
@@ -403,8 +461,9 @@ fn drive<M: Stepper>(
         if passive && drift.energy_rel > DIVERGENCE_ENERGY_REL {
             let what = format!(
                 "the energy balance (kinetic + elastic + dissipated) changed by {:.0}% by \
-                 t = {t1} s, which no passive scene can do: the integration is diverging",
-                100.0 * drift.energy_rel
+                 t = {}, which no passive scene can do: the integration is diverging",
+                100.0 * drift.energy_rel,
+                seconds(t1)
             );
             status = Some(Status::Failed {
                 diagnosis: diagnose(&what, t1, stepper.y(), scenario),
@@ -414,11 +473,11 @@ fn drive<M: Stepper>(
         if let Some((which, what)) = drift_excess(&limits, &drift, &warned, t1) {
             let message = drift_message(&what, t1, stepper.y(), scenario);
             match limits.on_drift {
-                OnDrift::Stop => {
+                OnBreach::Stop => {
                     status = Some(Status::Failed { diagnosis: message });
                     break;
                 }
-                OnDrift::Warn => {
+                OnBreach::Warn => {
                     warned[which] = true;
                     let w = Warning { t: t1, message };
                     sink.warning(&w)?;
@@ -449,8 +508,22 @@ fn drive<M: Stepper>(
             }
             window = (steps, t1);
         }
+        if !ranged.is_empty()
+            && let Some(s) = check_validity(
+                scenario,
+                &ranged,
+                &mut validity_reported,
+                t1,
+                stepper.y(),
+                sink,
+                &mut warnings,
+            )?
+        {
+            status = Some(s);
+            break;
+        }
         // The full observation (angles) only when events need it.
-        let o1 = if conditions.is_empty() {
+        let o1 = if watches.is_empty() {
             None
         } else {
             Some(sc.observe(t1, stepper.y()))
@@ -458,7 +531,8 @@ fn drive<M: Stepper>(
 
         // Events inside (t0, t1]: check interior points too, so that a quantity that crosses
         // and re-crosses within one long step is not missed.
-        let mut found: Vec<(f64, &Condition, bool)> = Vec::new();
+        // (event time, time known, condition, terminal)
+        let mut found: Vec<(f64, f64, &Condition, bool)> = Vec::new();
         if let Some(o1) = &o1 {
             // Reused across steps: no allocation per step once it has grown.
             grid.clear();
@@ -469,31 +543,49 @@ fn drive<M: Stepper>(
                 grid.push((t, sc.observe(t, &buf)));
             }
             grid.push((t1, o1.clone()));
-            for (c, terminal) in &conditions {
+            for watch in watches.iter_mut().filter(|w| w.active()) {
+                let c = watch.condition;
                 for w in grid.windows(2) {
+                    let (a, b) = (w[0].0, w[1].0);
                     let (ga, gb) = (c.margin(&w[0].1), c.margin(&w[1].1));
-                    if ga <= 0.0 && gb > 0.0 {
-                        let t = locate(&stepper, sc, c, w[0].0, w[1].0, ga, gb, &mut buf);
-                        found.push((t, c, *terminal));
-                        if *terminal {
+                    let crossing = |up: bool| {
+                        let mut scratch = vec![0.0; n];
+                        if up {
+                            locate(&stepper, sc, &|o| c.margin(o), a, b, ga, gb, &mut scratch)
+                        } else {
+                            locate(
+                                &stepper,
+                                sc,
+                                &|o| -c.margin(o),
+                                a,
+                                b,
+                                -ga,
+                                -gb,
+                                &mut scratch,
+                            )
+                        }
+                    };
+                    if let Some(f) = watch.advance(a, b, ga, gb, crossing) {
+                        found.push((f.t, f.confirmed, c, watch.terminal));
+                        if watch.terminal || !watch.active() {
                             break;
                         }
                     }
                 }
             }
-            found.sort_by(|a, b| a.0.total_cmp(&b.0));
-            if let Some(i) = found.iter().position(|f| f.2) {
+            found.sort_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some(i) = found.iter().position(|f| f.3) {
                 found.truncate(i + 1);
             }
         }
-        let stop_at = found.last().filter(|f| f.2).map(|f| f.0);
+        let stop_at = found.last().filter(|f| f.3).map(|f| f.1);
         let horizon = stop_at.unwrap_or(t1);
 
         // Samples on the grid up to the horizon, interleaved with events in time order.
         let mut pending = found.iter().peekable();
         loop {
             let tk = next_k as f64 / rate;
-            let next_event_t = pending.peek().map(|f| f.0);
+            let next_event_t = pending.peek().map(|f| f.1);
             let sample_due = tk <= horizon && tk <= t_end;
             match (sample_due, next_event_t) {
                 (true, Some(te)) if te < tk => {}
@@ -515,13 +607,14 @@ fn drive<M: Stepper>(
                 (false, Some(_)) => {}
             }
             // An event comes first.
-            let Some(&(te, c, terminal)) = pending.next() else {
+            let Some(&(t_event, te, c, terminal)) = pending.next() else {
                 break;
             };
             stepper.interpolate(te, &mut buf);
             let o = sc.observe(te, &buf);
             let e = EventRecord {
-                t: te,
+                t: t_event,
+                confirmed: te,
                 condition: c.describe(),
                 terminal,
             };
@@ -546,7 +639,9 @@ fn drive<M: Stepper>(
             prev = o1;
         }
     }
-    let status = status.unwrap_or(Status::Completed);
+    let status = status.unwrap_or(Status::Complete);
+    // With `for:`, events are known out of time order; list them in time order.
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
     // The last instant reached is always logged, on the grid or not.
     let final_state = if matches!(status, Status::Stopped { .. }) || last_good.is_some() {
         buf.clone()
@@ -585,12 +680,13 @@ fn drive<M: Stepper>(
     })
 }
 
-/// Locates the root of `c.margin` in `[a, b]` on the dense output (Illinois regula falsi).
+/// Locates the root of `margin` in `[a, b]` on the dense output (Illinois regula falsi),
+/// given `margin(a) = ga ≤ 0 < gb = margin(b)`.
 #[allow(clippy::too_many_arguments)]
 fn locate<M: Stepper>(
     stepper: &M,
     sc: &Spacecraft,
-    c: &Condition,
+    margin: &dyn Fn(&Observation) -> f64,
     mut a: f64,
     mut b: f64,
     mut ga: f64,
@@ -606,7 +702,7 @@ fn locate<M: Stepper>(
         }
         let t = ((a * gb - b * ga) / (gb - ga)).clamp(a.min(b), a.max(b));
         stepper.interpolate(t, buf);
-        let g = c.margin(&sc.observe(t, buf));
+        let g = margin(&sc.observe(t, buf));
         if g > 0.0 {
             b = t;
             gb = g;
@@ -658,7 +754,7 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         .then(|| crate::linearize::stiffness(sc, t, y, scenario.duration));
     let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
     let m = &scenario.method;
-    let (cause, remedy) = if let Some(found) = hinge_singularity(sc, y) {
+    let (cause, remedy) = if let Some(found) = model_outside_range(sc, y) {
         found
     } else {
         match (m.fixed_step(), stability_bound(m)) {
@@ -704,8 +800,9 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         }
     };
     format!(
-        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{state}]; suspected cause: \
-         {cause}; suggested remedy: {remedy}"
+        "{what}; state at t = {} [ω (rad/s), q (w,x,y,z)] = [{state}]; suspected cause: \
+         {cause}; suggested remedy: {remedy}",
+        seconds(t)
     )
 }
 
@@ -741,8 +838,9 @@ fn drift_excess(
             Some(b) if !warned[i] && *value > *b => Some((
                 i,
                 format!(
-                    "the {name} drifted by {value:.3e} by t = {t} s, beyond the bound {b:e} \
-                     (checks.max_drift)"
+                    "the {name} drifted by {value:.3e} by t = {}, beyond the bound {b:e} \
+                     (checks.max_drift)",
+                    seconds(t)
                 ),
             )),
             _ => None,
@@ -766,41 +864,102 @@ fn drift_message(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
         _ => "a looser bound if this accuracy is enough".into(),
     };
     format!(
-        "{what}; state at t = {t} s [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        "{what}; state at t = {} [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy}",
+        seconds(t),
         hub_state_text(y)
     )
 }
 
-/// A hinged rod with both flap and lag near flap = ±90°: there the rod lies along the lag
-/// axis, the flap–lag coordinates are singular (lag is undefined), and a lag spring or damper
-/// acting on a vanishing inertia makes the equations infinitely stiff. No integrator gets past
-/// it, so the diagnosis names it rather than blaming generic stiffness.
-fn hinge_singularity(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
-    for (k, e) in sc.effectors().iter().enumerate() {
-        let names = e.state_names();
-        if e.kind() != "hinged_rod" || names.first().map(String::as_str) != Some("flap") {
-            continue;
-        }
-        if names.get(1).map(String::as_str) != Some("lag") {
-            continue;
-        }
-        let flap = sc.effector_states(k, y)[0];
-        if flap.cos().abs() < 0.05 {
-            return Some((
+/// The first effector outside the range its model holds in at state `y`: `(cause, remedy)`.
+/// A failed integration near such a state is blamed on it rather than on generic stiffness
+/// (e.g. a flap–lag rod at its coordinate singularity, which no integrator gets past).
+fn model_outside_range(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
+    sc.effectors().iter().enumerate().find_map(|(k, e)| {
+        let x = sc.effector_states(k, y);
+        let v = e.validity(x)?;
+        v.past_limit().then(|| {
+            let (state, remedy) = e.validity_report(x);
+            (
                 format!(
-                    "the hinged rod `{}` has swung to flap = {:.2}°: at ±90° it lies along its \
-                     lag axis, where the flap–lag angles are singular (lag is undefined) and \
-                     the lag spring and damper act on no inertia",
-                    e.name(),
-                    flap.to_degrees()
+                    "{} `{}` left its model's range: {state}",
+                    e.kind(),
+                    e.name()
                 ),
-                "keep the rod away from 90° flap (a stiffer flap spring, a smaller initial \
-                 flap rate), or give it one freedom (`freedom: flap` or `lag`)"
-                    .into(),
-            ));
+                remedy,
+            )
+        })
+    })
+}
+
+/// Checks the effectors with a validity range (`ranged`) at state `y` and time `t`: warns
+/// once past each one's warning threshold (and once more past its limit under
+/// `checks.on_validity: warn`); past a limit under `stop`, returns the invalid-model status.
+#[allow(clippy::too_many_arguments)]
+fn check_validity(
+    scenario: &Scenario,
+    ranged: &[usize],
+    reported: &mut [u8],
+    t: f64,
+    y: &[f64],
+    sink: &mut dyn Sink,
+    warnings: &mut Vec<Warning>,
+) -> std::io::Result<Option<Status>> {
+    let sc = &scenario.spacecraft;
+    for &k in ranged {
+        let e = &sc.effectors()[k];
+        let x = sc.effector_states(k, y);
+        let Some(v) = e.validity(x) else {
+            continue;
+        };
+        let level = if v.past_limit() {
+            2
+        } else if v.past_warning() {
+            1
+        } else {
+            0
+        };
+        if level <= reported[k] {
+            continue;
         }
+        let (state, remedy) = e.validity_report(x);
+        let stop = level == 2 && scenario.drift_limits.on_validity == OnBreach::Stop;
+        if stop {
+            return Ok(Some(Status::InvalidModel {
+                diagnosis: format!(
+                    "{} `{}` left the range its model holds in at t = {}: {state}; hub state \
+                     [ω (rad/s), q (w,x,y,z)] = [{}]; suggested remedy: {remedy} (or \
+                     `checks: {{on_validity: warn}}` to go on regardless)",
+                    e.kind(),
+                    e.name(),
+                    seconds(t),
+                    hub_state_text(y)
+                ),
+            }));
+        }
+        reported[k] = level;
+        let message = if level == 2 {
+            format!(
+                "{} `{}` left the range its model holds in at t = {}: {state}; the run goes on \
+                 (checks.on_validity: warn) but its results from here are not to be trusted; \
+                 suggested remedy: {remedy}",
+                e.kind(),
+                e.name(),
+                seconds(t)
+            )
+        } else {
+            format!(
+                "{} `{}` nears the edge of the range its model holds in at t = {}: {state}; \
+                 suggested remedy: {remedy}",
+                e.kind(),
+                e.name(),
+                seconds(t)
+            )
+        };
+        let w = Warning { t, message };
+        sink.warning(&w)?;
+        warnings.push(w);
     }
-    None
+    Ok(None)
 }
 
 /// The hub's rates and attitude (the first seven states) for diagnoses.

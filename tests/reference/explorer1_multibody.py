@@ -284,9 +284,9 @@ def main():
     KE_sym = fKE(th0, u0)
     H0 = np.linalg.norm(d0["H"])
     E0 = d0["T"] + d0["V"]
-    print(f"initial |H| = {H0:.8f} N m s   (reference sheet 11.806)")
-    print(f"initial T   = {d0['T']:.8f} J       (reference sheet 463.16)")
-    print(f"initial nutation angle = {d0['nut']:.8f} deg  (reference sheet 2.668)")
+    print(f"initial |H| = {H0:.8f} N m s   (docs/validation.md: 11.806)")
+    print(f"initial T   = {d0['T']:.8f} J       (docs/validation.md: 463.16)")
+    print(f"initial nutation angle = {d0['nut']:.8f} deg  (docs/validation.md: 2.668)")
     print(f"initial v_hub (hub axes) = {v0}  |P| = {np.linalg.norm(d0['P']):.3e}")
     print(f"check: sympy KE at t0 = {KE_sym:.12f}, numpy T_abs = {d0['T_abs']:.12f}, "
           f"rel diff {abs(KE_sym - d0['T_abs']) / d0['T_abs']:.2e}")
