@@ -98,6 +98,11 @@ enum Command {
         /// Simulated duration for every scenario (s), overrides each `duration`.
         #[arg(long)]
         duration: Option<f64>,
+        /// An event column, written like an `events:` item, e.g.
+        /// `{nutation_angle_deg: {above: 45.0, once: true}}`; repeatable. Replaces the
+        /// scenarios' own `events:` as the columns.
+        #[arg(long = "event", value_name = "CONDITION")]
+        events: Vec<String>,
     },
     /// Benchmarks of the integration methods (docs/choosing-a-method.md).
     Bench {
@@ -314,12 +319,14 @@ pub fn main() -> i32 {
             csv,
             json,
             duration,
+            events,
         } => compare_cmd(
             &scenarios,
             chart.as_deref(),
             csv.as_deref(),
             json.as_deref(),
             duration,
+            &events,
         ),
         Command::Linearize { scenario, json } => linearize_cmd(&scenario, json.as_deref()),
         Command::Montecarlo {
@@ -532,12 +539,23 @@ fn compare_cmd(
     csv: Option<&Path>,
     json: Option<&Path>,
     duration: Option<f64>,
+    events: &[String],
 ) -> i32 {
     let overrides = Overrides {
         duration,
         ..Overrides::default()
     };
     // Validate everything before running anything.
+    let mut option_events = Vec::new();
+    for text in events {
+        match scenario::parse_condition(text) {
+            Ok(c) => option_events.push(c),
+            Err(e) => {
+                eprintln!("error: --event '{text}': {e}");
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
     let mut scenarios = Vec::new();
     for p in paths {
         match load(p, &overrides) {
@@ -545,6 +563,7 @@ fn compare_cmd(
             Err(c) => return c,
         }
     }
+    let columns = crate::compare::Columns::new(&scenarios, &option_events);
     let interrupt = Arc::new(AtomicBool::new(false));
     {
         let flag = interrupt.clone();
@@ -557,7 +576,7 @@ fn compare_cmd(
         if tty {
             eprintln!("[{}/{count}] {} …", i + 1, s.name);
         }
-        match crate::compare::run_one(s, &interrupt) {
+        match crate::compare::run_one(s, &columns, &interrupt) {
             Ok(r) => rows.push(r),
             Err(e) => {
                 eprintln!("error: {e}");
@@ -569,7 +588,7 @@ fn compare_cmd(
             break;
         }
     }
-    let table = crate::compare::table(&rows);
+    let table = crate::compare::table(&rows, &columns);
     let title = format!(
         "Nutation angle: {}",
         rows.iter()
@@ -579,7 +598,7 @@ fn compare_cmd(
     );
     let mut outputs: Vec<(&Path, String)> = Vec::new();
     if let Some(p) = chart {
-        outputs.push((p, crate::compare::chart(&rows, &title)));
+        outputs.push((p, crate::compare::chart(&rows, &columns, &title)));
     }
     if let Some(p) = csv {
         outputs.push((p, crate::compare::series_csv(&rows)));

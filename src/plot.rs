@@ -1365,23 +1365,55 @@ pub fn svg_and_png(
     chart: &Chart,
     stem: &std::path::Path,
 ) -> Result<Vec<std::path::PathBuf>, String> {
+    svg_and_png_as(chart, &[stem])
+}
+
+/// Like [`svg_and_png`], under each of `stems` (the chart is drawn and rasterised once; every
+/// copy is the same bytes): `<stem>.svg` and `<stem>.png` for each stem in order, each written
+/// under a temporary name and renamed when complete. Returns the paths in that order.
+pub fn svg_and_png_as(
+    chart: &Chart,
+    stems: &[&std::path::Path],
+) -> Result<Vec<std::path::PathBuf>, String> {
+    let Some((first, rest)) = stems.split_first() else {
+        return Ok(Vec::new());
+    };
     let svg = chart.to_svg(900, 600);
-    let svg_path = stem.with_extension("svg");
-    crate::log::write_atomically(&svg_path, svg.as_bytes())
-        .map_err(|e| format!("{}: {e}", svg_path.display()))?;
-    let png_path = stem.with_extension("png");
-    let name = png_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = png_path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    let result = write_png(&svg, &tmp)
-        .and_then(|()| std::fs::rename(&tmp, &png_path).map_err(|e| e.to_string()));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(format!("{}: {e}", png_path.display()));
+    let mut written = Vec::new();
+    let png_path = first.with_extension("png");
+    let mut png: Option<Vec<u8>> = None;
+    for stem in std::iter::once(first).chain(rest) {
+        let svg_path = stem.with_extension("svg");
+        crate::log::write_atomically(&svg_path, svg.as_bytes())
+            .map_err(|e| format!("{}: {e}", svg_path.display()))?;
+        written.push(svg_path);
+        let path = stem.with_extension("png");
+        match &png {
+            None => {
+                let name = path
+                    .file_name()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+                let result = write_png(&svg, &tmp)
+                    .and_then(|()| std::fs::rename(&tmp, &path).map_err(|e| e.to_string()));
+                if let Err(e) = result {
+                    let _ = std::fs::remove_file(&tmp);
+                    return Err(format!("{}: {e}", path.display()));
+                }
+                if !rest.is_empty() {
+                    png = Some(
+                        std::fs::read(&png_path)
+                            .map_err(|e| format!("{}: {e}", png_path.display()))?,
+                    );
+                }
+            }
+            Some(bytes) => crate::log::write_atomically(&path, bytes)
+                .map_err(|e| format!("{}: {e}", path.display()))?,
+        }
+        written.push(path);
     }
-    Ok(vec![svg_path, png_path])
+    Ok(written)
 }
 
 #[cfg(test)]

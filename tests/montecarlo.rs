@@ -107,6 +107,18 @@ fn threads_order_and_shards_give_the_same_result_bit_for_bit() {
         "scenario.yaml",
         "summary.json",
         "summary.txt",
+        "t_nutation_angle_deg_above_45_cdf.png",
+        "t_nutation_angle_deg_above_45_cdf.svg",
+        "t_nutation_angle_deg_above_45_histogram.png",
+        "t_nutation_angle_deg_above_45_histogram.svg",
+        "t_nutation_angle_deg_above_45_vs_transverse_rate.png",
+        "t_nutation_angle_deg_above_45_vs_transverse_rate.svg",
+        "t_nutation_angle_deg_above_80_cdf.png",
+        "t_nutation_angle_deg_above_80_cdf.svg",
+        "t_nutation_angle_deg_above_80_histogram.png",
+        "t_nutation_angle_deg_above_80_histogram.svg",
+        "t_nutation_angle_deg_above_80_vs_transverse_rate.png",
+        "t_nutation_angle_deg_above_80_vs_transverse_rate.svg",
         "transverse_rate_vs_flat_spin_time.png",
         "transverse_rate_vs_flat_spin_time.svg",
     ];
@@ -578,4 +590,120 @@ fn every_shipped_campaign_is_valid() {
                 .unwrap_or_else(|e| panic!("{}: run {i}: {e}", path.display()));
         }
     }
+}
+
+/// Width and height of a PNG file, after checking its signature and that it ends with IEND.
+fn png_size(bytes: &[u8]) -> (u32, u32) {
+    assert!(bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    assert_eq!(&bytes[12..16], b"IHDR");
+    assert!(bytes.ends_with(&[0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82]));
+    let be = |k: usize| u32::from_be_bytes(bytes[k..k + 4].try_into().unwrap());
+    (be(16), be(20))
+}
+
+#[test]
+fn every_event_gets_its_own_charts() {
+    let dir = scratch("event-charts");
+    // Two events of different kinds: the first crossing of 45°, and 80° held for 5 s (the
+    // flat spin: the nutation event with the highest `above`).
+    let text = std::fs::read_to_string(root().join(SCENARIO)).unwrap();
+    let two = text.replace(
+        "  - {nutation_angle_deg: {above: 45.0}}\n  - {nutation_angle_deg: {above: 80.0}}\n",
+        "  - {nutation_angle_deg: {above: 45.0, once: true}}\n  - {nutation_angle_deg: {above: 80.0, for: 5.0}}\n",
+    );
+    assert_ne!(two, text);
+    let scenario = dir.join("two-events.yaml");
+    std::fs::write(&scenario, &two).unwrap();
+    let out = dir.join("out");
+    campaign(&[scenario.to_str().unwrap(), "--runs", "24"], &out);
+
+    let summary = json(&out.join("summary.json"));
+    let charts = summary["charts"].as_array().unwrap();
+    assert_eq!(charts.len(), 2, "{charts:?}");
+    let columns = [
+        "t_nutation_angle_deg_above_45_once",
+        "t_nutation_angle_deg_above_80_for_5_s",
+    ];
+    let text_summary = std::fs::read_to_string(out.join("summary.txt")).unwrap();
+    let mut svgs = Vec::new();
+    for (c, column) in charts.iter().zip(columns) {
+        assert_eq!(c["column"], column);
+        let files: Vec<&str> = c["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        let expected: Vec<String> = ["histogram", "cdf", "vs_transverse_rate"]
+            .iter()
+            .flat_map(|k| [format!("{column}_{k}.svg"), format!("{column}_{k}.png")])
+            .collect();
+        assert_eq!(files, expected);
+        for f in &files {
+            let bytes = std::fs::read(out.join(f)).unwrap();
+            if f.ends_with(".svg") {
+                let svg = String::from_utf8(bytes).unwrap();
+                assert!(
+                    svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+                    "{f}"
+                );
+                svgs.push(svg);
+            } else {
+                assert_eq!(png_size(&bytes), (1350, 900), "{f}");
+            }
+            assert!(text_summary.contains(&f.replace(".svg", ".svg/png")) || f.ends_with(".png"));
+        }
+    }
+    // The two events' charts differ (their times and titles), chart by chart.
+    for k in 0..3 {
+        assert_ne!(svgs[k], svgs[3 + k], "chart {k}");
+        assert!(svgs[3 + k].contains("flat spin"), "chart {k}");
+        assert!(
+            svgs[k].contains("nutation_angle_deg above 45 once"),
+            "chart {k}"
+        );
+    }
+    // The flat spin's charts keep their historical names, the same bytes as its own.
+    let flat = charts[1]["flat_spin_files"].as_array().unwrap();
+    assert_eq!(flat.len(), 6);
+    assert_eq!(charts[0]["flat_spin_files"], serde_json::json!([]));
+    for (old, new) in flat.iter().zip(charts[1]["files"].as_array().unwrap()) {
+        let (old, new) = (old.as_str().unwrap(), new.as_str().unwrap());
+        assert_eq!(
+            std::fs::read(out.join(old)).unwrap(),
+            std::fs::read(out.join(new)).unwrap(),
+            "{old} vs {new}"
+        );
+    }
+
+    // A campaign with one event written into the same directory leaves no chart of the
+    // other; a shard writes none and lists none.
+    let one = text.replace("  - {nutation_angle_deg: {above: 45.0}}\n", "");
+    let single = dir.join("one-event.yaml");
+    std::fs::write(&single, &one).unwrap();
+    campaign(&[single.to_str().unwrap(), "--runs", "8"], &out);
+    let names: Vec<String> = files(&out)
+        .into_keys()
+        .filter(|n| n.starts_with("t_"))
+        .collect();
+    assert_eq!(names.len(), 6, "{names:?}");
+    assert!(
+        names
+            .iter()
+            .all(|n| n.starts_with("t_nutation_angle_deg_above_80_")),
+        "{names:?}"
+    );
+    campaign(
+        &[single.to_str().unwrap(), "--runs", "8", "--shard", "1/2"],
+        &out,
+    );
+    assert!(
+        files(&out)
+            .keys()
+            .all(|n| !n.ends_with(".svg") && !n.ends_with(".png"))
+    );
+    assert_eq!(
+        json(&out.join("summary.json"))["charts"],
+        serde_json::json!([])
+    );
 }

@@ -2,7 +2,8 @@
 //! writes the combined result.
 //!
 //! Files: `runs.csv`, `runs.parquet`, `summary.json`, `summary.txt`, `scenario.yaml` (the
-//! scenario as given), and for a whole campaign (not a shard) the charts and
+//! scenario as given), and for a whole campaign (not a shard) the charts (three for each
+//! event, named after its column, and the flat spin's under their historical names too) and
 //! `campaign.mcap`. `campaign.json`, the manifest, is written last: a directory without it
 //! holds no finished result. Every file is written under a temporary name and renamed.
 
@@ -44,15 +45,48 @@ const OUTPUT_FILES: [&str; 13] = [
     "transverse_rate_vs_flat_spin_time.png",
 ];
 
+/// Suffixes of an event's chart files after its column name (`t_<condition>`): the
+/// histogram, the CDF and the scatter against the initial transverse rate.
+const EVENT_CHART_SUFFIXES: [&str; 3] = ["_histogram", "_cdf", "_vs_transverse_rate"];
+
+/// Whether `name` is the file name of an event chart ([`EVENT_CHART_SUFFIXES`]); the events,
+/// and so these names, differ between campaigns.
+fn is_event_chart(name: &str) -> bool {
+    let Some(stem) = name
+        .strip_suffix(".svg")
+        .or_else(|| name.strip_suffix(".png"))
+    else {
+        return false;
+    };
+    name.starts_with("t_")
+        && !name.starts_with('.')
+        && EVENT_CHART_SUFFIXES.iter().any(|s| stem.ends_with(s))
+}
+
 /// Removes a previous campaign's outputs from `dir` (the manifest first).
 pub fn clear_outputs(dir: &Path) -> Result<(), String> {
+    let remove = |p: PathBuf| match std::fs::remove_file(&p) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(format!("cannot remove the old {}: {e}", p.display())),
+    };
     for name in OUTPUT_FILES {
-        let p = dir.join(name);
-        match std::fs::remove_file(&p) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(format!("cannot remove the old {}: {e}", p.display())),
-        }
+        remove(dir.join(name))?;
+    }
+    // The event charts, whose names come from the previous campaign's events.
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(format!("cannot list {}: {e}", dir.display())),
+    };
+    let mut old: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| is_event_chart(&e.file_name().to_string_lossy()))
+        .map(|e| e.path())
+        .collect();
+    old.sort();
+    for p in old {
+        remove(p)?;
     }
     Ok(())
 }
@@ -114,6 +148,7 @@ struct SummaryDoc<'a> {
     status: StatusCounts,
     percentiles: &'static [f64],
     events: Vec<EventStats>,
+    charts: Vec<EventCharts>,
     ranking: Option<Ranking>,
     columns: Vec<ColumnStats>,
     failures: Vec<Failure>,
@@ -171,7 +206,8 @@ pub fn write_outputs(
         columns: prep.columns.clone(),
         runs_csv_sha256: sha256_hex(csv.as_bytes()),
     };
-    let doc = summary_doc(prep, rows, &manifest);
+    let plan = chart_plan(prep, rows, shard);
+    let doc = summary_doc(prep, rows, &manifest, plan);
     let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
     put(&mut written, "summary.json", json.as_bytes())?;
     put(
@@ -181,7 +217,7 @@ pub fn write_outputs(
     )?;
     let mut mcap_interrupted = false;
     if shard.is_none() {
-        written.extend(charts(dir, prep, rows)?);
+        written.extend(charts(dir, prep, rows, &doc.charts)?);
         if let Some(r) = &doc.ranking
             && !partial
         {
@@ -199,7 +235,12 @@ pub fn write_outputs(
     })
 }
 
-fn summary_doc<'a>(prep: &'a Prepared, rows: &[Row], m: &'a Manifest) -> SummaryDoc<'a> {
+fn summary_doc<'a>(
+    prep: &'a Prepared,
+    rows: &[Row],
+    m: &'a Manifest,
+    charts: Vec<EventCharts>,
+) -> SummaryDoc<'a> {
     let events = prep
         .event_conditions
         .iter()
@@ -229,6 +270,7 @@ fn summary_doc<'a>(prep: &'a Prepared, rows: &[Row], m: &'a Manifest) -> Summary
         status: summary::status_counts(rows),
         percentiles: &summary::PERCENTILES,
         events,
+        charts,
         ranking: summary::rank(rows, &prep.rank_rule()),
         columns,
         failures: summary::failures(rows),
@@ -293,6 +335,24 @@ fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
             );
         }
     }
+    if !d.charts.is_empty() {
+        let _ = writeln!(out, "\ncharts:");
+        for c in &d.charts {
+            let list = |stems: &[String]| {
+                stems
+                    .iter()
+                    .map(|s| format!("{s}.svg/png"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let flat = if c.flat_spin.is_empty() {
+                String::new()
+            } else {
+                format!("\n    the flat spin, also as {}", list(&c.flat_spin))
+            };
+            let _ = writeln!(out, "  event `{}`: {}{flat}", c.condition, list(&c.charts));
+        }
+    }
     if let Some(r) = &d.ranking {
         let _ = writeln!(
             out,
@@ -315,15 +375,116 @@ fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
     out
 }
 
-/// Histogram and CDF of the flat-spin time, and initial transverse rate against it.
-fn charts(dir: &Path, prep: &Prepared, rows: &[Row]) -> Result<Vec<PathBuf>, String> {
-    let Some(j) = prep.primary_event else {
-        return Ok(vec![]);
-    };
+/// The charts of one event, as listed in the summary (stems: add `.svg` and `.png`).
+#[derive(Debug, Clone, Serialize)]
+struct EventCharts {
+    /// The event's condition.
+    condition: String,
+    /// Its table column (`t_<condition>`), which names its charts.
+    column: String,
+    /// Table column index.
+    #[serde(skip)]
+    j: usize,
+    /// Histogram, CDF and scatter: `<column>_histogram`, `<column>_cdf`,
+    /// `<column>_vs_transverse_rate` (stems).
+    #[serde(skip)]
+    charts: Vec<String>,
+    /// For the flat-spin event, the same charts under their historical names
+    /// (`flat_spin_time_histogram`, `flat_spin_time_cdf`,
+    /// `transverse_rate_vs_flat_spin_time`); empty for the others.
+    #[serde(skip)]
+    flat_spin: Vec<String>,
+    /// The files: each of `charts` as `.svg` and `.png`.
+    files: Vec<String>,
+    /// The same for `flat_spin`: the flat spin's charts under their historical names.
+    flat_spin_files: Vec<String>,
+}
+
+/// `<stem>.svg` and `<stem>.png` of each stem.
+fn svg_png(stems: &[String]) -> Vec<String> {
+    stems
+        .iter()
+        .flat_map(|s| [format!("{s}.svg"), format!("{s}.png")])
+        .collect()
+}
+
+/// Historical names of the flat-spin event's charts, in the order of [`EVENT_CHART_SUFFIXES`].
+const FLAT_SPIN_CHARTS: [&str; 3] = [
+    "flat_spin_time_histogram",
+    "flat_spin_time_cdf",
+    "transverse_rate_vs_flat_spin_time",
+];
+
+/// The charts a whole campaign draws: three for each event that some usable run reached, in
+/// the order of the events. None for a shard (the merge draws them).
+fn chart_plan(prep: &Prepared, rows: &[Row], shard: Option<[u64; 2]>) -> Vec<EventCharts> {
+    if shard.is_some() {
+        return Vec::new();
+    }
+    prep.event_conditions
+        .iter()
+        .enumerate()
+        .filter_map(|(k, condition)| {
+            let j = prep.event_start + k;
+            rows.iter()
+                .any(|r| r.status.ok() && r.values[j].is_some())
+                .then(|| {
+                    let column = prep.columns[j].clone();
+                    let charts: Vec<String> = EVENT_CHART_SUFFIXES
+                        .iter()
+                        .map(|s| format!("{column}{s}"))
+                        .collect();
+                    let flat_spin = if prep.primary_event == Some(j) {
+                        FLAT_SPIN_CHARTS.map(String::from).to_vec()
+                    } else {
+                        Vec::new()
+                    };
+                    EventCharts {
+                        condition: condition.clone(),
+                        column,
+                        j,
+                        files: svg_png(&charts),
+                        flat_spin_files: svg_png(&flat_spin),
+                        charts,
+                        flat_spin,
+                    }
+                })
+        })
+        .collect()
+}
+
+/// Draws every event's charts as planned by [`chart_plan`].
+fn charts(
+    dir: &Path,
+    prep: &Prepared,
+    rows: &[Row],
+    plan: &[EventCharts],
+) -> Result<Vec<PathBuf>, String> {
+    let mut out = Vec::new();
+    for p in plan {
+        let drawn = event_charts(prep, rows, p.j, !p.flat_spin.is_empty());
+        for (k, chart) in drawn.iter().enumerate() {
+            let mut stems = vec![dir.join(&p.charts[k])];
+            if let Some(name) = p.flat_spin.get(k) {
+                stems.push(dir.join(name));
+            }
+            let stems: Vec<&Path> = stems.iter().map(PathBuf::as_path).collect();
+            out.extend(
+                crate::plot::svg_and_png_as(chart, &stems)
+                    .map_err(|e| format!("cannot write {e}"))?,
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// Histogram and CDF of the time of the event of column `j`, and initial transverse rate
+/// against it (titled as the flat spin when `flat_spin`). Empty when no usable run reached it.
+fn event_charts(prep: &Prepared, rows: &[Row], j: usize, flat_spin: bool) -> Vec<Chart> {
     let usable: Vec<&Row> = rows.iter().filter(|r| r.status.ok()).collect();
     let mut times: Vec<f64> = usable.iter().filter_map(|r| r.values[j]).collect();
     if times.is_empty() {
-        return Ok(vec![]);
+        return vec![];
     }
     times.sort_by(f64::total_cmp);
     let condition = &prep.event_conditions[j - prep.event_start];
@@ -355,16 +516,17 @@ fn charts(dir: &Path, prep: &Prepared, rows: &[Row]) -> Result<Vec<PathBuf>, Str
         outline.push((x1, *c as f64));
     }
     outline.push((minutes(lo + span), 0.0));
-    let mut h = Chart::new(
-        format!("Time to flat spin ({condition}): {reached} of {n} runs"),
-        "time (min)",
-        "runs per bin",
-    );
+    let title = if flat_spin {
+        format!("Time to flat spin ({condition}): {reached} of {n} runs")
+    } else {
+        format!("Time to `{condition}`: {reached} of {n} runs")
+    };
+    let mut h = Chart::new(title, "time (min)", "runs per bin");
     h.x_range = Some((minutes(lo - 0.05 * span), minutes(hi + 0.05 * span)));
     let tallest = counts.iter().copied().max().unwrap_or(1) as f64;
     h.y_range = Some((0.0, 1.1 * tallest));
     h.series.push(Series::new("", outline, Style::Line));
-    out.extend(chart_files(&h, dir, "flat_spin_time_histogram")?);
+    out.push(h);
 
     // CDF over all usable runs: it ends below 1 when some runs never reach the event.
     // From t = 0 to the end of the scenario, so both ends of the staircase are visible.
@@ -377,32 +539,37 @@ fn charts(dir: &Path, prep: &Prepared, rows: &[Row]) -> Result<Vec<PathBuf>, Str
         minutes(prep.scenario.duration.max(hi)),
         reached as f64 / n as f64,
     ));
-    let mut c = Chart::new(
-        format!("Probability of a flat spin ({condition}) by time"),
-        "time (min)",
-        "fraction of runs",
-    );
+    let title = if flat_spin {
+        format!("Probability of a flat spin ({condition}) by time")
+    } else {
+        format!("Probability of `{condition}` by time")
+    };
+    let mut c = Chart::new(title, "time (min)", "fraction of runs");
     c.y_range = Some((0.0, 1.05));
     c.series.push(Series::new("", cdf, Style::Line));
-    out.extend(chart_files(&c, dir, "flat_spin_time_cdf")?);
+    out.push(c);
 
     // Scatter.
     let points: Vec<(f64, f64)> = usable
         .iter()
         .filter_map(|r| Some((r.values[prep.transverse_column]?, minutes(r.values[j]?))))
         .collect();
-    let mut s = Chart::new(
-        "Initial transverse rate against time to flat spin",
-        "initial transverse rate (rad/s)",
-        "time to flat spin (min)",
-    );
+    let mut s = if flat_spin {
+        Chart::new(
+            "Initial transverse rate against time to flat spin",
+            "initial transverse rate (rad/s)",
+            "time to flat spin (min)",
+        )
+    } else {
+        Chart::new(
+            format!("Initial transverse rate against time to `{condition}`"),
+            "initial transverse rate (rad/s)",
+            "time of the event (min)",
+        )
+    };
     s.series.push(Series::new("", points, Style::Markers));
-    out.extend(chart_files(&s, dir, "transverse_rate_vs_flat_spin_time")?);
-    Ok(out)
-}
-
-fn chart_files(chart: &Chart, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, String> {
-    crate::plot::svg_and_png(chart, &dir.join(stem)).map_err(|e| format!("cannot write {e}"))
+    out.push(s);
+    out
 }
 
 /// `campaign.mcap`: the worst, median and best runs re-run with full logging under

@@ -1832,6 +1832,42 @@ fn sanitize(name: &str) -> String {
         .collect()
 }
 
+/// Parses one condition written like an item of `events:` or `stop:`, e.g.
+/// `{nutation_angle_deg: {above: 45.0, once: true}}` (for `polhode compare --event`), with the
+/// checks and messages a scenario file gets. The error names the column in `text` and the
+/// field, e.g. ``column 24: field `nutation_angle_deg.for`: expected a duration ≥ 0 s …``.
+pub fn parse_condition(text: &str) -> Result<Condition, String> {
+    const EXPECTED: &str = "expected one condition such as `{nutation_angle_deg: {above: 45.0}}` \
+                            (an `events:` list item; see docs/scenarios.md)";
+    let path = Path::new("--event");
+    let render = |e: ScenarioError| {
+        let mut out = String::new();
+        if let Some(c) = e.column {
+            out += &format!("column {c}: ");
+        }
+        if let Some(f) = &e.field {
+            let f = f.strip_prefix("event[0].").unwrap_or(f);
+            out += &format!("field `{f}`: ");
+        }
+        out + &e.message
+    };
+    if text.trim().is_empty() {
+        return Err(EXPECTED.into());
+    }
+    let spec: Spanned<ConditionSpec> = serde_saphyr::from_str(text).map_err(|e| {
+        let err = yaml_error(path, text, &e);
+        if err.message.starts_with("the document is not a mapping")
+            || err.message.starts_with("the file is empty")
+        {
+            EXPECTED.to_string()
+        } else {
+            render(err)
+        }
+    })?;
+    let mut list = conditions(path, "event", std::slice::from_ref(&spec)).map_err(render)?;
+    Ok(list.remove(0))
+}
+
 fn conditions(
     path: &Path,
     field: &str,
