@@ -663,8 +663,37 @@ fn check(paths: &[PathBuf]) -> i32 {
             s.output_rate,
             s.mcap_path.display()
         );
+        if let Some(line) = hub_remainder_line(&s) {
+            println!("{line}");
+        }
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
     }
     code
+}
+
+/// With `body.composite: true`, the hub's own mass properties polhode derived (the whole
+/// spacecraft minus the effectors at rest), for `check` and `run`.
+fn hub_remainder_line(s: &Scenario) -> Option<String> {
+    let c = s.composite.as_ref()?;
+    let sc = &s.spacecraft;
+    let p = sc.hub.principal_moments;
+    // `+ 0.0` turns −0 into 0, so no component prints as `-0.000000000e0`.
+    let o = c.hub_offset.map(|x| x + 0.0);
+    let mass = match (c.total_mass, sc.hub_mass) {
+        (Some(total), Some(hub)) => format!(
+            "mass {hub:.9e} kg (of {total} kg; effectors {:.9e} kg), ",
+            c.effector_mass
+        ),
+        _ => String::new(),
+    };
+    Some(format!(
+        "  hub (composite body minus the effectors at rest): {mass}centre of mass \
+         [{:+.9e}, {:+.9e}, {:+.9e}] m from the whole spacecraft's, principal moments \
+         {:.9e}, {:.9e}, {:.9e} kg m²",
+        o[0], o[1], o[2], p[0], p[1], p[2]
+    ))
 }
 
 fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
@@ -896,6 +925,9 @@ fn run(
         Ok(s) => s,
         Err(c) => return c,
     };
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
     if let Some(p) = summary_path
         && !no_log
         && same_file(p, &s.mcap_path)
@@ -1225,6 +1257,9 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
             a[1],
             a[2]
         );
+    }
+    if let Some(line) = hub_remainder_line(s) {
+        println!("{line}");
     }
     println!(
         "  status: {}{}",

@@ -73,7 +73,8 @@ pub struct SpringMassSpec {
     pub name: Option<String>,
     /// Particle mass (kg).
     pub mass: Spanned<f64>,
-    /// Point of the line at zero offset (m, body axes, about the hub's centre of mass).
+    /// Point of the line at zero offset (m, body axes, about the hub's centre of mass, or the
+    /// whole spacecraft's with `body.composite`).
     pub position: Spanned<[f64; 3]>,
     /// Direction of the line (body axes).
     pub direction: Spanned<[f64; 3]>,
@@ -157,7 +158,8 @@ pub struct HingedRodSpec {
     pub mass: Spanned<f64>,
     /// Rod length (m).
     pub length: Spanned<f64>,
-    /// Hinge point (m, body axes, about the hub's centre of mass); must be on or in the body.
+    /// Hinge point (m, body axes, about the hub's centre of mass, or the whole spacecraft's
+    /// with `body.composite`); checked to be on or in `body.shape` when one is given.
     pub hinge: Spanned<[f64; 3]>,
     /// Rest direction of the rod (body axes).
     pub direction: Spanned<[f64; 3]>,
@@ -197,7 +199,8 @@ pub struct ModalSpec {
     /// Tip mass (kg).
     #[serde(default)]
     pub tip_mass: Option<Spanned<f64>>,
-    /// Root point (m, body axes, about the hub's centre of mass); must be on or in the body.
+    /// Root point (m, body axes, about the hub's centre of mass, or the whole spacecraft's
+    /// with `body.composite`); checked to be on or in `body.shape` when one is given.
     pub attachment: Spanned<[f64; 3]>,
     /// Beam direction (body axes).
     pub direction: Spanned<[f64; 3]>,
@@ -342,21 +345,35 @@ impl Check<'_> {
         // Remove the rounding-level component, so the frame is orthonormal to 1e-16.
         Ok((v - c * to).normalize())
     }
+    /// A point that must be on or inside the hub, as written (before any composite shift).
+    /// Checked against `body.shape`; without one, nothing is invented: the point is taken as
+    /// given and a located warning says what to add to have it checked.
     fn on_body(
         &self,
         s: &Spanned<[f64; 3]>,
         key: &str,
-        shape: &Shape,
+        what: &str,
+        cx: &Context,
     ) -> Result<Vector3<f64>, ScenarioError> {
         let p = self.point(s, key)?;
+        let Some(shape) = cx.shape else {
+            cx.notes.borrow_mut().push(self.err(
+                s,
+                key,
+                format!(
+                    "placement not checked: give `body.shape` (a box or a cylinder, in body \
+                     axes) to check that {what} is on or inside the body"
+                ),
+            ));
+            return Ok(p);
+        };
         if let Some(excess) = outside(shape, &p) {
             return Err(self.err(
                 s,
                 key,
                 format!(
                     "the point [{}, {}, {}] m is outside the body by {excess:.4} m: it must be \
-                     on or inside the hub's shape (`body.shape`, or the box equivalent to the \
-                     inertia when no shape is given)",
+                     on or inside the hub's shape (`body.shape`)",
                     p[0], p[1], p[2]
                 ),
             ));
@@ -413,9 +430,16 @@ fn outside(shape: &Shape, p: &Vector3<f64>) -> Option<f64> {
 pub(super) struct Context<'a> {
     pub path: &'a Path,
     pub hub: &'a RigidBody,
-    pub shape: &'a Shape,
+    /// `body.shape`, if given: placement is checked against it, and only then.
+    pub shape: Option<&'a Shape>,
     pub spin_axis: Vector3<f64>,
     pub omega0: Vector3<f64>,
+    /// Added to every position after its placement check (and after `copies` turn it): zero,
+    /// or with `body.composite` minus the hub's centre of mass, moving positions written about
+    /// the whole spacecraft's centre of mass to the hub's.
+    pub shift: Vector3<f64>,
+    /// Located warnings (placements that could not be checked).
+    pub notes: std::cell::RefCell<Vec<ScenarioError>>,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -508,7 +532,8 @@ pub(super) fn build(
             EffectorSpec::SpringMassDamper(s) => {
                 let model = SpringMass {
                     mass: ck.positive(&s.mass, "mass", "kg")?,
-                    position: ck.on_body(&s.position, "position", cx.shape)?,
+                    position: ck.on_body(&s.position, "position", "the line's point", cx)?
+                        + cx.shift,
                     direction: ck.unit(&s.direction, "direction")?,
                     stiffness: ck.non_negative(&s.stiffness, "stiffness", "N/m")?,
                     damping: ck.non_negative(&s.damping, "damping", "N s/m")?,
@@ -535,8 +560,8 @@ pub(super) fn build(
                     damping: ck.non_negative(&w.damping, "damping", "N m s/rad")?,
                     initial_rate: ck.finite(&w.initial_rate, "initial_rate", "rad/s")?,
                     position: match &w.position {
-                        Some(p) => ck.point(p, "position")?,
-                        None => Vector3::zeros(),
+                        Some(p) => ck.point(p, "position")? + cx.shift,
+                        None => cx.shift,
                     },
                     max_speed: w
                         .max_speed
@@ -579,7 +604,7 @@ pub(super) fn build(
                 let length = ck.positive(&h.length, "length", "m")?;
                 let direction = ck.unit(&h.direction, "direction")?;
                 let axis = ck.perpendicular(&h.axis, "axis", &direction, "direction")?;
-                let hinge = ck.on_body(&h.hinge, "hinge", cx.shape)?;
+                let hinge = ck.on_body(&h.hinge, "hinge", "the hinge", cx)?;
                 let pair = |s: &Spanned<PerAngle>, key: &str, unit: &str| {
                     let p = s.value.pair();
                     if p.iter().all(|x| (0.0..=MAX_MAGNITUDE).contains(x)) {
@@ -617,7 +642,7 @@ pub(super) fn build(
                     let rod = HingedRod {
                         mass,
                         length,
-                        hinge: rot * hinge,
+                        hinge: rot * hinge + cx.shift,
                         direction: rot * direction,
                         axis: rot * axis,
                         freedom,
@@ -655,7 +680,7 @@ pub(super) fn build(
                 let flap =
                     ck.perpendicular(&m.flap_direction, "flap_direction", &direction, "direction")?;
                 let lag = direction.cross(&flap);
-                let attachment = ck.on_body(&m.attachment, "attachment", cx.shape)?;
+                let attachment = ck.on_body(&m.attachment, "attachment", "the root", cx)?;
                 let which = match m.bending.as_ref().map(|b| b.value.as_str()) {
                     None | Some("both") => vec![true, true],
                     Some("flap") => vec![true, false],
@@ -701,7 +726,7 @@ pub(super) fn build(
                     let n = q0.len();
                     let beam = ModalBeam::new(
                         modes.clone(),
-                        rot * attachment,
+                        rot * attachment + cx.shift,
                         rot * direction,
                         bending,
                         zeta,
@@ -746,9 +771,10 @@ fn check_copies_on_body(
     spec: &Option<CopiesSpec>,
     rotations: &[UnitQuaternion<f64>],
     point: &Vector3<f64>,
-    shape: &Shape,
+    shape: Option<&Shape>,
 ) -> Result<(), ScenarioError> {
-    let Some(c) = spec else {
+    // Without `body.shape` the first point's warning already says what is missing.
+    let (Some(c), Some(shape)) = (spec, shape) else {
         return Ok(());
     };
     for (k, rot) in rotations.iter().enumerate() {

@@ -155,10 +155,12 @@ pub struct DriftLimits {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
-    /// Hub mass (kg), excluding effectors that move mass; needed when there are such.
+    /// Hub mass (kg), excluding effectors that move mass; needed when there are such. With
+    /// `composite: true`, the whole spacecraft's mass.
     #[serde(default)]
     pub mass: Option<Spanned<f64>>,
-    /// Full inertia tensor about the centre of mass, body axes (kg m², rows).
+    /// Full inertia tensor about the centre of mass, body axes (kg m², rows). With
+    /// `composite: true`, the whole spacecraft's, effectors at rest, about its centre of mass.
     #[serde(default)]
     pub inertia: Option<Spanned<[[f64; 3]; 3]>>,
     /// Principal moments along body x, y, z (kg m²), instead of `inertia`.
@@ -167,9 +169,15 @@ pub struct BodySpec {
     /// Body axis whose angle to H is reported as the nutation angle.
     #[serde(default)]
     pub spin_axis: Option<Spanned<[f64; 3]>>,
-    /// Shape drawn in viewers (default: a box with the proportions of the inertia).
+    /// Shape drawn in viewers (default: a box with the proportions of the inertia), and
+    /// against which effector placement is checked (not checked without it).
     #[serde(default)]
     pub shape: Option<Spanned<ShapeSpec>>,
+    /// The mass properties are the whole spacecraft's (hub, appendages and dampers at rest,
+    /// about the whole spacecraft's centre of mass), as mass-properties reports give them;
+    /// polhode subtracts the effectors at rest to get the hub's own (docs/conventions.md).
+    #[serde(default)]
+    pub composite: Option<Spanned<bool>>,
 }
 
 /// A shape for the 3D view, in body axes, centred on the centre of mass.
@@ -573,6 +581,23 @@ pub enum Shape {
     },
 }
 
+/// `body.composite: true`: the whole spacecraft's mass properties as given, and what polhode
+/// took away to get the hub's own (kept in [`Scenario::spacecraft`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompositeHub {
+    /// The whole spacecraft's mass as given (kg), if given (it is needed only when effectors
+    /// move mass).
+    pub total_mass: Option<f64>,
+    /// The whole spacecraft's inertia about its centre of mass as given (kg m², body axes).
+    pub total_inertia: Matrix3<f64>,
+    /// Mass of the effectors that move mass, at rest (kg).
+    pub effector_mass: f64,
+    /// The hub's centre of mass relative to the whole spacecraft's (m, body axes): the
+    /// effectors' positions, given about the whole spacecraft's centre of mass, were shifted
+    /// by minus this to be about the hub's.
+    pub hub_offset: Vector3<f64>,
+}
+
 /// A validated scenario, ready to run.
 #[derive(Debug)]
 pub struct Scenario {
@@ -612,6 +637,11 @@ pub struct Scenario {
     pub events: Vec<Condition>,
     /// Shape for viewers.
     pub shape: Shape,
+    /// With `body.composite: true`, the whole spacecraft as given and the hub's remainder.
+    pub composite: Option<CompositeHub>,
+    /// Located warnings found while loading (e.g. a placement that could not be checked),
+    /// printed by `check` and `run`.
+    pub warnings: Vec<ScenarioError>,
     /// The `montecarlo:` block as written, checked by `montecarlo::Campaign::new`.
     pub montecarlo: Option<crate::montecarlo::CampaignFile>,
     /// Drift bounds checked at every step (`checks:`).
@@ -1221,18 +1251,7 @@ impl ScenarioFile {
                 }
                 v.normalize()
             }
-            None => {
-                let h = hub.inertia * omega0;
-                let axes = hub.principal_axes;
-                let best = (0..3)
-                    .max_by(|&a, &b| {
-                        let da = axes.column(a).dot(&h).abs();
-                        let db = axes.column(b).dot(&h).abs();
-                        da.total_cmp(&db)
-                    })
-                    .unwrap_or(2);
-                axes.column(best).into_owned()
-            }
+            None => default_spin_axis(&hub, &omega0),
         };
 
         // Where a value came from: a command-line option (no line; the option is named) or the
@@ -1601,17 +1620,14 @@ impl ScenarioFile {
         let stop = conditions(path, "stop", &self.stop)?;
         let events = conditions(path, "events", &self.events)?;
 
-        let shape = match &self.body.shape {
-            None => Shape::Box {
-                size: hub.equivalent_box(1.0),
-                orientation: UnitQuaternion::from_matrix(&hub.principal_axes),
-            },
-            Some(s) => shape(path, s)?,
+        let given_shape = match &self.body.shape {
+            None => None,
+            Some(s) => Some(shape(path, s)?),
         };
-
-        let mut spacecraft = Spacecraft::new(hub, spin_axis);
-        if let Some(m) = &self.body.mass {
-            if !in_positive_range(m.value) {
+        let mass = match &self.body.mass {
+            None => None,
+            Some(m) if in_positive_range(m.value) => Some(m.value),
+            Some(m) => {
                 return Err(err(
                     loc(m),
                     "body.mass",
@@ -1622,16 +1638,69 @@ impl ScenarioFile {
                     ),
                 ));
             }
-            spacecraft.hub_mass = Some(m.value);
-        }
+        };
+        // The effectors as written: positions about the hub's centre of mass, or, with
+        // `composite: true`, about the whole spacecraft's.
         let cx = effectors::Context {
             path,
-            hub: &spacecraft.hub,
-            shape: &shape,
+            hub: &hub,
+            shape: given_shape.as_ref(),
             spin_axis,
             omega0,
+            shift: Vector3::zeros(),
+            notes: std::cell::RefCell::new(Vec::new()),
         };
-        for e in effectors::build(&cx, &self.effectors)? {
+        let mut built = effectors::build(&cx, &self.effectors)?;
+        let mut warnings = cx.notes.into_inner();
+        let (hub, hub_mass, spin_axis, composite_hub) =
+            if self.body.composite.as_ref().is_some_and(|c| c.value) {
+                let (hub, mass, offset, effector_mass) = composite_remainder(
+                    path,
+                    &self.body,
+                    hub,
+                    mass,
+                    (inertia_loc, inertia_field),
+                    &built,
+                )?;
+                let spin_axis = match &self.body.spin_axis {
+                    Some(_) => spin_axis,
+                    None => default_spin_axis(&hub, &omega0),
+                };
+                if effector_mass > 0.0 {
+                    // Again, with the hub's own inertia and every position moved to be about
+                    // the hub's centre of mass (placement is checked where it was written).
+                    let cx = effectors::Context {
+                        path,
+                        hub: &hub,
+                        shape: given_shape.as_ref(),
+                        spin_axis,
+                        omega0,
+                        shift: -offset,
+                        notes: std::cell::RefCell::new(Vec::new()),
+                    };
+                    built = effectors::build(&cx, &self.effectors)?;
+                    warnings = cx.notes.into_inner();
+                }
+                let report = CompositeHub {
+                    total_mass: self.body.mass.as_ref().map(|m| m.value),
+                    total_inertia: inertia,
+                    effector_mass,
+                    hub_offset: offset,
+                };
+                (hub, mass, spin_axis, Some(report))
+            } else {
+                (hub, mass, spin_axis, None)
+            };
+        // Without `body.shape` the viewer draws a box with the inertia's proportions; nothing
+        // is checked against it.
+        let shape = given_shape.unwrap_or_else(|| Shape::Box {
+            size: hub.equivalent_box(1.0),
+            orientation: UnitQuaternion::from_matrix(&hub.principal_axes),
+        });
+
+        let mut spacecraft = Spacecraft::new(hub, spin_axis);
+        spacecraft.hub_mass = hub_mass;
+        for e in built {
             spacecraft.add_effector(e).map_err(|e| {
                 err(
                     self.body.mass.as_ref().and_then(loc),
@@ -1747,11 +1816,152 @@ impl ScenarioFile {
             stop,
             events,
             shape,
+            composite: composite_hub,
+            warnings,
             montecarlo: self.montecarlo,
             drift_limits,
             max_log_mb,
         })
     }
+}
+
+/// The principal axis of `hub` closest to the initial angular momentum `I ω₀`.
+fn default_spin_axis(hub: &RigidBody, omega0: &Vector3<f64>) -> Vector3<f64> {
+    let h = hub.inertia * omega0;
+    let axes = hub.principal_axes;
+    let best = (0..3)
+        .max_by(|&a, &b| {
+            let da = axes.column(a).dot(&h).abs();
+            let db = axes.column(b).dot(&h).abs();
+            da.total_cmp(&db)
+        })
+        .unwrap_or(2);
+    axes.column(best).into_owned()
+}
+
+/// `body.composite: true`: the hub's own mass properties, the whole spacecraft's as given
+/// (`total` about its centre of mass O, `mass`) minus the mass-moving `effectors` at rest, built
+/// with their positions about O. With the effectors' mass m_e, first moment s and inertia J about
+/// O, the hub has mass m_h = M − m_e and, O being the centre of mass of the whole
+/// (m_h c + s = 0), its centre of mass at c = −s / m_h from O; by the parallel-axis theorem its
+/// inertia about O is I_h + m_h (|c|² 1 − c cᵀ), so about its own centre of mass
+/// I_h = I − J − m_h (|c|² 1 − c cᵀ). Returns the hub, m_h, c and m_e; refuses a remainder
+/// that is not a physical body, with the numbers.
+fn composite_remainder(
+    path: &Path,
+    body: &BodySpec,
+    total: RigidBody,
+    mass: Option<f64>,
+    (inertia_loc, inertia_field): (Option<(u32, u32)>, &str),
+    effectors: &[Box<dyn crate::model::Effector>],
+) -> Result<(RigidBody, Option<f64>, Vector3<f64>, f64), ScenarioError> {
+    let (m_e, first, j) = rest_mass_properties(effectors);
+    if m_e == 0.0 {
+        return Ok((total, mass, Vector3::zeros(), 0.0));
+    }
+    // 11 significant digits: the numbers as given, without the subtraction's rounding noise.
+    let short = |x: f64| number(format!("{x:.10e}").parse().unwrap_or(x));
+    let Some(m_total) = mass else {
+        return Err(ScenarioError::at(
+            path,
+            loc_of(&body.composite),
+            "body.mass",
+            format!(
+                "with `composite: true` and effectors that move mass ({} kg of them), expected \
+                 `body.mass`: the whole spacecraft's mass (kg)",
+                short(m_e)
+            ),
+        ));
+    };
+    let m_h = m_total - m_e;
+    if !in_positive_range(m_h) {
+        return Err(ScenarioError::at(
+            path,
+            loc_of(&body.mass),
+            "body.mass",
+            format!(
+                "with `composite: true` this is the whole spacecraft's mass, {} kg, and the \
+                 effectors that move mass weigh {} kg, leaving {} kg for the hub: the effectors \
+                 outweigh the total given (the hub's own mass must be at least {MIN_POSITIVE:e} \
+                 kg)",
+                short(m_total),
+                short(m_e),
+                short(m_h)
+            ),
+        ));
+    }
+    let c = -first / m_h;
+    let taken = j + m_h * (Matrix3::identity() * c.norm_squared() - c * c.transpose());
+    let remainder = total.inertia - taken;
+    let remainder = 0.5 * (remainder + remainder.transpose());
+    let moments = |m: &Matrix3<f64>| {
+        let mut e: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+        e.sort_by(f64::total_cmp);
+        e.iter()
+            .map(|x| format!("{x:.6e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let refuse = |why: String| {
+        ScenarioError::at(
+            path,
+            inertia_loc,
+            inertia_field,
+            format!(
+                "with `composite: true` this is the whole spacecraft's inertia (principal moments \
+                 {} kg m²), and the hub's own is what remains after taking away the effectors \
+                 at rest, which account for principal moments {} kg m² about the whole \
+                 spacecraft's centre of mass (the hub's own centre of mass, [{}, {}, {}] m from \
+                 it, included): the effectors out-inertia the total given, and the remainder \
+                 {why}",
+                moments(&total.inertia),
+                moments(&taken),
+                short(c[0]),
+                short(c[1]),
+                short(c[2]),
+            ),
+        )
+    };
+    let hub = RigidBody::new(remainder)
+        .map_err(|e| refuse(format!("is not a physical inertia tensor: {e}")))?;
+    let p = hub.principal_moments;
+    if p.min() < MIN_MOMENT_RATIO * p.max() {
+        return Err(refuse(format!(
+            "has principal moments {:.6e}, {:.6e}, {:.6e} kg m², the smallest below \
+             {MIN_MOMENT_RATIO:e} of the largest",
+            p[0], p[1], p[2]
+        )));
+    }
+    Ok((hub, Some(m_h), c, m_e))
+}
+
+/// Mass, first moment (kg m) and inertia (kg m², body axes) of the mass-moving effectors at
+/// rest (every effector state zero), about the origin their positions are given from. Read
+/// from each effector's own momentum, so every kind (and every copy) counts as it moves.
+fn rest_mass_properties(
+    effectors: &[Box<dyn crate::model::Effector>],
+) -> (f64, Vector3<f64>, Matrix3<f64>) {
+    let attitude = [1.0, 0.0, 0.0, 0.0];
+    let (mut mass, mut first, mut inertia) = (0.0, Vector3::zeros(), Matrix3::zeros());
+    for e in effectors.iter().filter(|e| e.moves_mass()) {
+        let x = vec![0.0; e.num_states()];
+        let at = |omega: Vector3<f64>| {
+            let hub = crate::model::HubState {
+                t: 0.0,
+                omega,
+                attitude: &attitude,
+            };
+            e.momentum(&hub, &x)
+        };
+        let still = at(Vector3::zeros());
+        mass += still.mass;
+        first += still.first_moment;
+        for c in 0..3 {
+            let column = at(Vector3::ith(c, 1.0)).angular - still.angular;
+            inertia.set_column(c, &(inertia.column(c) + column));
+        }
+    }
+    (mass, first, inertia)
 }
 
 /// Stiffness ratio above which `auto` picks the implicit method: an explicit method's stable
