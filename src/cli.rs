@@ -724,13 +724,13 @@ fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
         }
         println!(
             "{}: hub driven ({}); effector modes at ω = [{:.6}, {:.6}, {:.6}] rad/s (the rate \
-             at t = {} s)",
+             at t = {})",
             s.name,
             motion.describe(),
             omega[0],
             omega[1],
             omega[2],
-            s.duration
+            crate::timefmt::seconds(s.duration)
         );
         println!(
             "  {:>16} {:>16}  {:<12} time constant",
@@ -1328,8 +1328,8 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     }
     for e in o.events.iter().take(PRINTED_EVENTS) {
         println!(
-            "  event: t = {:.9} s  {}{}",
-            e.t,
+            "  event: t = {}  {}{}",
+            crate::timefmt::seconds(e.t),
             e.condition,
             if e.terminal { " (stop)" } else { "" }
         );

@@ -436,3 +436,116 @@ fn a_mistyped_subcommand_gets_a_suggestion() {
     let out = polhode().arg("xyzzy").output().unwrap();
     assert!(!text(&out.stderr).contains("similar"));
 }
+
+/// `polhode check` on `yaml`: (exit code, stderr).
+fn check_text(name: &str, yaml: &str) -> (Option<i32>, String) {
+    let dir = scratch(name);
+    std::fs::write(dir.join("s.yaml"), yaml).unwrap();
+    let out = polhode()
+        .args(["check", "s.yaml"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    (out.status.code(), text(&out.stderr))
+}
+
+const HEAD: &str = "name: x\nbody: {principal: [1, 2, 3], mass: 10}\ninitial:\n  omega: [0.1, 0, 1]\nduration: 1\n";
+
+/// Semantic errors carry the line and column (before: the energy sink combined with a wheel
+/// had neither), event errors their list index, and an attitude given as a list the form to
+/// use.
+#[test]
+fn errors_are_located_and_say_what_to_write() {
+    let cases = [
+        (
+            "sink",
+            format!(
+                "{HEAD}effectors:\n  - wheel_damper: {{inertia: 0.01, axis: [0, 0, 1], damping: 0.1}}\n  - energy_sink: {{coefficient: 0.1}}\n"
+            ),
+            "s.yaml:8:5: field `effectors[1].energy_sink`: an energy sink models",
+        ),
+        (
+            "rayleigh",
+            format!("{HEAD}effectors:\n  - rayleigh: {{name: r}}\n"),
+            "s.yaml:7:5: field `effectors[0].rayleigh`: expected exactly one of `gamma",
+        ),
+        (
+            "attitude",
+            HEAD.replace(
+                "  omega: [0.1, 0, 1]\n",
+                "  omega: [0.1, 0, 1]\n  attitude: [1, 0, 0, 0]\n",
+            ),
+            "s.yaml:5:13: field `initial.attitude`: expected a quaternion as a mapping `{w: 1.0, x: 0.0, y: 0.0, z: 0.0}`",
+        ),
+        (
+            "event-threshold",
+            format!(
+                "{HEAD}events:\n  - nutation_angle_deg: {{above: 1}}\n  - nutation_angle_deg: 5\n"
+            ),
+            "s.yaml:8:25: field `events[1].nutation_angle_deg`: expected a threshold mapping `{above: X}` or `{below: X}`, got `5`",
+        ),
+        (
+            "event-two",
+            format!(
+                "{HEAD}stop:\n  - {{nutation_angle_deg: {{above: 1}}, omega_x: {{above: 1}}}}\n"
+            ),
+            "field `stop[0]`: expected one condition per list item",
+        ),
+        (
+            "event-for",
+            format!(
+                "{HEAD}events:\n  - omega_z: {{above: 1}}\n  - omega_z: {{below: 1, for: -2}}\n"
+            ),
+            "s.yaml:8:5: field `events[1].omega_z.for`: expected a duration ≥ 0 s",
+        ),
+    ];
+    for (name, yaml, expect) in cases {
+        let (code, err) = check_text(name, &yaml);
+        assert_eq!(code, Some(2), "{name}: {err}");
+        assert!(err.contains(expect), "{name}: expected {expect:?} in {err}");
+    }
+}
+
+/// In a campaign, runs stopped outside their model's validity get their own status, are
+/// counted, and are left out of event probabilities, which say how many they exclude.
+#[test]
+fn campaigns_count_and_exclude_invalid_model_runs() {
+    let dir = scratch("mc-invalid");
+    // EI below about 5 N m² takes the floppy boom past δ/L = 0.3 within 600 s; above about 10
+    // it stays inside.
+    let yaml = std::fs::read_to_string(repo("scenarios/floppy-boom.yaml"))
+        .unwrap()
+        .replace("duration: 3600.0", "duration: 600.0")
+        + "montecarlo:\n  runs: 8\n  seed: 3\n  dispersions:\n    - {path: \"effectors[boom].bending_stiffness\", uniform: {min: 1.5, max: 12.0}}\n  probability_by: [300]\n";
+    std::fs::write(dir.join("mc.yaml"), yaml).unwrap();
+    let out = polhode()
+        .args(["montecarlo", "mc.yaml", "-q", "--out", "out"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let summary = read_json(&dir.join("out/summary.json"));
+    let status = &summary["status"];
+    let invalid_model = status["invalid_model"].as_u64().unwrap();
+    let usable = status["complete"].as_u64().unwrap() + status["stopped"].as_u64().unwrap();
+    assert!(invalid_model > 0 && usable > 0, "{status}");
+    let event = &summary["events"][0];
+    assert_eq!(event["runs"].as_u64().unwrap(), usable, "{event}");
+    assert_eq!(event["excluded"].as_u64().unwrap(), 8 - usable, "{event}");
+    assert_eq!(
+        event["excluded_invalid_model"].as_u64().unwrap(),
+        invalid_model
+    );
+    let table = std::fs::read_to_string(dir.join("out/runs.csv")).unwrap();
+    assert_eq!(
+        table.matches(",invalid_model,").count() as u64,
+        invalid_model,
+        "{table}"
+    );
+    let text_summary = std::fs::read_to_string(dir.join("out/summary.txt")).unwrap();
+    assert!(
+        text_summary.contains(&format!("{invalid_model} invalid_model")),
+        "{text_summary}"
+    );
+    assert!(text_summary.contains("runs excluded ("), "{text_summary}");
+}

@@ -132,8 +132,9 @@ impl Prepared {
             }
             Err(_) => false,
         };
+        let block = crate::scenario::key_location(&scenario.source, "montecarlo");
         if !same {
-            return Err(ScenarioError::whole_file(&path, QUOTE));
+            return Err(ScenarioError::at(&path, block, "montecarlo", QUOTE));
         }
         let mut campaign = Campaign::new(&path, file, &tree, scenario.duration)?;
         if let Some(r) = runs {
@@ -257,11 +258,13 @@ impl Prepared {
         let mut seen = std::collections::BTreeSet::new();
         for c in &columns {
             if !seen.insert(c.as_str()) {
-                return Err(ScenarioError::whole_file(
+                return Err(ScenarioError::at(
                     &path,
+                    block,
+                    "montecarlo.dispersions",
                     format!(
-                        "montecarlo: two table columns would be named `{c}`; a dispersion \
-                         path must not be named like a metric column"
+                        "two table columns would be named `{c}`; a dispersion path must not \
+                         be named like a metric column"
                     ),
                 ));
             }

@@ -445,10 +445,13 @@ pub(super) struct Context<'a> {
 /// Validates `effectors:` and builds them, in order.
 pub(super) fn build(
     cx: &Context,
-    specs: &[EffectorSpec],
+    specs: &[Spanned<EffectorSpec>],
 ) -> Result<Vec<Box<dyn Effector>>, ScenarioError> {
     let mut out: Vec<Box<dyn Effector>> = Vec::new();
-    for (i, spec) in specs.iter().enumerate() {
+    for (i, spanned) in specs.iter().enumerate() {
+        let spec = &spanned.value;
+        // Where the list item starts, for errors about the item as a whole.
+        let item = loc(spanned);
         let kind = match spec {
             EffectorSpec::Rayleigh(_) => "rayleigh",
             EffectorSpec::EnergySink(_) => "energy_sink",
@@ -488,7 +491,7 @@ pub(super) fn build(
                     _ => {
                         return Err(ScenarioError::at(
                             cx.path,
-                            None,
+                            item,
                             ck.prefix.clone(),
                             "expected exactly one of `gamma: [[..],[..],[..]]` or \
                              `gamma_diagonal: [g1, g2, g3]` (N m s/rad)",
@@ -516,7 +519,7 @@ pub(super) fn build(
                     _ => {
                         return Err(ScenarioError::at(
                             cx.path,
-                            None,
+                            item,
                             ck.prefix.clone(),
                             "expected exactly one of `coefficient` (N m s/rad) or \
                              `time_constant` (s)",
@@ -747,7 +750,7 @@ pub(super) fn build(
     // when no other effector carries momentum.
     let sink = specs
         .iter()
-        .position(|s| matches!(s, EffectorSpec::EnergySink(_)));
+        .position(|s| matches!(s.value, EffectorSpec::EnergySink(_)));
     if let Some(i) = sink
         && out
             .iter()
@@ -755,7 +758,7 @@ pub(super) fn build(
     {
         return Err(ScenarioError::at(
             cx.path,
-            None,
+            loc(&specs[i]),
             format!("effectors[{i}].energy_sink"),
             "an energy sink models the internal dissipation of a quasi-rigid body and cannot \
              be combined with effectors that carry momentum of their own (dampers, rods, \

@@ -81,7 +81,7 @@ pub struct ScenarioFile {
     pub events: Vec<Spanned<ConditionSpec>>,
     /// Parts beyond the rigid hub: dampers, appendages, dissipation torques.
     #[serde(default)]
-    pub effectors: Vec<EffectorSpec>,
+    pub effectors: Vec<Spanned<EffectorSpec>>,
     /// A prescribed hub rotation (the hub's centre of mass is then pinned).
     #[serde(default)]
     pub hub_motion: Option<HubMotionSpec>,
@@ -832,6 +832,28 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
             "expected a number{found} (plain numbers in SI units, no unit suffix; angles in \
              radians unless the key ends in `_deg`)"
         );
+    } else if (field.starts_with("events[") || field.starts_with("stop["))
+        && (message == "expected mapping start"
+            || message == "expected end of mapping after enum variant value")
+    {
+        message = if message.starts_with("expected end") {
+            "expected one condition per list item: put each `QUANTITY: {above: X}` on its own \
+             `-` line"
+                .into()
+        } else if field.contains('.') {
+            format!(
+                "expected a threshold mapping `{{above: X}}` or `{{below: X}}`{found}, with \
+                 optional `once: true` and `for: SECONDS`"
+            )
+        } else {
+            format!("expected a condition such as `nutation_angle_deg: {{above: 45.0}}`{found}")
+        };
+    } else if message == "expected mapping start" && field.ends_with("attitude") {
+        message = format!(
+            "expected a quaternion as a mapping `{{w: 1.0, x: 0.0, y: 0.0, z: 0.0}}`{found} \
+             (body to inertial, Hamilton); a list is refused because whether its scalar comes \
+             first or last would be a guess"
+        );
     } else if message == "expected sequence start" {
         message = format!("expected a list `[...]`{found}");
     } else if message == "expected string scalar" {
@@ -1064,7 +1086,7 @@ fn drift_limits(
 }
 
 /// Where the top-level `key:` is written (line, column), for errors about what it lacks.
-fn key_location(source: &str, key: &str) -> Option<(u32, u32)> {
+pub(crate) fn key_location(source: &str, key: &str) -> Option<(u32, u32)> {
     error::yaml_lines(source)
         .into_iter()
         .position(|l| {
