@@ -1249,13 +1249,16 @@ fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
         "  principal moments {:.9e}, {:.9e}, {:.9e} kg m²",
         m[0], m[1], m[2]
     );
+    // Rounded to the digits printed before the sign is chosen, so that a component of
+    // −1e-17 from the eigensolver prints as +0, not −0.
+    let digits = |v: f64| (v * 1e9).round() / 1e9 + 0.0;
     for (i, a) in b.principal_axes.iter().enumerate() {
         println!(
             "    axis {}: [{:+.9}, {:+.9}, {:+.9}]",
             i + 1,
-            a[0],
-            a[1],
-            a[2]
+            digits(a[0]),
+            digits(a[1]),
+            digits(a[2])
         );
     }
     if let Some(line) = hub_remainder_line(s) {

@@ -1628,6 +1628,21 @@ const ALL_KEYS: &[&str] = &[
     "initial_tip_deflection",
     "spin_up",
     "ramp_time",
+    "composite",
+    "travel",
+    "max_speed",
+    "once",
+    "for",
+    "above",
+    "below",
+    "checks",
+    "max_drift",
+    "on_drift",
+    "on_validity",
+    "momentum",
+    "energy",
+    "quaternion_norm",
+    "max_log_mb",
 ];
 
 impl Valid {

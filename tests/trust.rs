@@ -376,6 +376,16 @@ fn principal_axes_follow_the_documented_convention() {
         json["body"]["principal_axes"][2],
         serde_json::json!([1.0, 0.0, 0.0])
     );
+    // Explorer 1's eigensolver leaves components of order 1e-17: they print as +0.
+    let out = run(
+        &dir,
+        &repo("scenarios/explorer1.yaml"),
+        &["--duration", "0.01"],
+    );
+    let stdout = text(&out.stdout);
+    let axes: Vec<&str> = stdout.lines().filter(|l| l.contains("axis ")).collect();
+    assert_eq!(axes.len(), 3, "{stdout}");
+    assert!(axes.iter().all(|l| !l.contains('-')), "{axes:?}");
 }
 
 /// `polhode check` validates the `montecarlo:` block with `montecarlo`'s own message (before:
