@@ -307,10 +307,11 @@ enum Item {
 
 #[derive(Arbitrary, Debug)]
 enum EndStatus {
-    Completed,
+    Complete,
     Stopped(String),
     Interrupted,
     Failed(String),
+    InvalidModel(String),
 }
 
 #[derive(Arbitrary, Debug)]
@@ -375,12 +376,15 @@ fn outcome_of(r: &RunCase) -> Outcome {
     let o = r.final_obs.build();
     let mut outcome = outcome_template().clone();
     outcome.status = match &r.status {
-        EndStatus::Completed => Status::Completed,
+        EndStatus::Complete => Status::Complete,
         EndStatus::Stopped(c) => Status::Stopped {
             condition: c.clone(),
         },
         EndStatus::Interrupted => Status::Interrupted,
         EndStatus::Failed(d) => Status::Failed {
+            diagnosis: d.clone(),
+        },
+        EndStatus::InvalidModel(d) => Status::InvalidModel {
             diagnosis: d.clone(),
         },
     };
@@ -511,6 +515,7 @@ fn fuzz_mcap(case: McapCase) {
                 } => {
                     let e = EventRecord {
                         t: *t,
+                        confirmed: *t,
                         condition: condition.clone(),
                         terminal: *terminal,
                     };
@@ -681,6 +686,7 @@ enum ArbStatus {
     Stopped,
     Failed,
     Invalid,
+    InvalidModel,
 }
 
 impl ArbStatus {
@@ -690,6 +696,7 @@ impl ArbStatus {
             ArbStatus::Stopped => RunStatus::Stopped,
             ArbStatus::Failed => RunStatus::Failed,
             ArbStatus::Invalid => RunStatus::Invalid,
+            ArbStatus::InvalidModel => RunStatus::InvalidModel,
         }
     }
 }
@@ -970,15 +977,16 @@ fn fuzz_outputs(case: OutputsCase) {
         rows.dedup_by_key(|r| r.run);
         let finished_all = rows.len() as u64 == range.end - range.start;
         let partial = case.partial || !finished_all;
-        // A whole campaign with a flat-spin time charts it: three PNGs rasterised by resvg,
-        // about 1.5 s each under instrumentation, which would take most of the fuzzer's time
-        // for code that is not polhode's. Such inputs are written as the single shard 1/1
-        // (the same table and summary) unless POLHODE_FUZZ_CHARTS=1; the charts' SVG is
-        // fuzzed on its own by the `Chart` case.
+        // A whole campaign charts every event that a usable run reached: three PNGs per
+        // event rasterised by resvg, about 1.5 s each under instrumentation, which would take
+        // most of the fuzzer's time for code that is not polhode's. Such inputs are written
+        // as the single shard 1/1 (the same table and summary) unless POLHODE_FUZZ_CHARTS=1;
+        // the charts' SVG is fuzzed on its own by the `Chart` case.
+        let event_columns = prep.event_start..prep.event_start + prep.event_conditions.len();
         let charted = shard.is_none()
-            && prep
-                .primary_event
-                .is_some_and(|j| rows.iter().any(|r| r.status.ok() && r.values[j].is_some()));
+            && rows.iter().any(|r| {
+                r.status.ok() && event_columns.clone().any(|j| r.values[j].is_some())
+            });
         let shard = if charted && !charts_enabled() {
             Some([1, 1])
         } else {

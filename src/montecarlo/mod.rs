@@ -52,8 +52,8 @@ pub struct Prepared {
     pub transverse_column: usize,
     /// The conditions of the event columns.
     pub event_conditions: Vec<String>,
-    /// First event column.
-    event_start: usize,
+    /// First event column (the event columns follow in the order of `event_conditions`).
+    pub event_start: usize,
     /// Column of the largest nutation.
     max_nutation_column: usize,
 }
