@@ -189,9 +189,75 @@ fn bench_effector_rhs(repeats: usize) {
     }
 }
 
+/// What the gravity gradient adds to a rigid body's right-hand side, as a ratio in one run:
+/// the same body without and with it, in a circular orbit and in an eccentric one (where
+/// every call solves Kepler's equation at its own time; times spread over an orbit).
+fn bench_environment_rhs(repeats: usize) {
+    use polhode::integrate::OdeSystem;
+    let yaml = |orbit: &str, effectors: &str| {
+        format!(
+            "name: b\nbody: {{principal: [3, 5, 7]}}\n{orbit}initial: {{omega: [0.01, 0.02, 0.03]}}\nduration: 1\n{effectors}"
+        )
+    };
+    let load = |text: String| {
+        scenario::parse(Path::new("bench.yaml"), text, &Overrides::default()).expect("scenario")
+    };
+    let calls = 20_000;
+    fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
+        let sc = &s.spacecraft;
+        let y = sc.initial_state(&s.omega0, &s.attitude0);
+        let mut dy = vec![0.0; sc.dim()];
+        move || {
+            for k in 0..calls {
+                sc.rhs(black_box(k as f64 * 0.37), black_box(&y), &mut dy);
+                black_box(&dy);
+            }
+        }
+    }
+    let rigid = load(yaml("", ""));
+    println!(
+        "\ntorque effectors (the machinery alone, then the gravity gradient), one \
+         right-hand-side evaluation against the rigid body:"
+    );
+    let gravity = "effectors:\n  - gravity_gradient: {}\n";
+    for (label, orbit, effectors) in [
+        (
+            "rayleigh (Γ = 0)",
+            "",
+            "effectors:\n  - rayleigh: {gamma_diagonal: [0, 0, 0]}\n",
+        ),
+        (
+            "circular orbit",
+            "orbit: {semi_major_axis_km: 6978.137}\n",
+            gravity,
+        ),
+        (
+            "e = 0.7 orbit",
+            "orbit: {semi_major_axis_km: 25000, eccentricity: 0.7}\n",
+            gravity,
+        ),
+    ] {
+        let with = load(yaml(orbit, effectors));
+        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
+        let mut f_base = time_rhs(&rigid, calls);
+        let mut f = time_rhs(&with, calls);
+        for _ in 0..repeats {
+            base_best = base_best.min(min_time(1, &mut f_base));
+            best = best.min(min_time(1, &mut f));
+        }
+        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
+        println!(
+            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
+            ns - base_ns,
+            ns / base_ns
+        );
+    }
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 15 };
+    bench_environment_rhs(repeats);
     bench_effector_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(

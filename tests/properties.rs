@@ -1643,6 +1643,19 @@ const ALL_KEYS: &[&str] = &[
     "energy",
     "quaternion_norm",
     "max_log_mb",
+    "orbit",
+    "frame",
+    "gravity_gradient",
+    "central_body",
+    "semi_major_axis_km",
+    "perigee_altitude_km",
+    "apogee_altitude_km",
+    "eccentricity",
+    "inclination_deg",
+    "raan_deg",
+    "arg_perigee_deg",
+    "true_anomaly_deg",
+    "j2_secular",
 ];
 
 impl Valid {

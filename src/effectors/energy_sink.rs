@@ -56,6 +56,9 @@ impl Effector for EnergySink {
         // Keeps |H| but turns H_N.
         true
     }
+    fn torque_only(&self) -> bool {
+        true
+    }
     fn couple(&self, hub: &HubState, _x: &[f64], c: &mut HubCoupling, _s: &mut [f64]) {
         c.add_torque(&(-self.coefficient * self.transverse_rate(&hub.omega)));
     }
@@ -75,6 +78,7 @@ impl Effector for EnergySink {
             elastic: 0.0,
             dissipated: x[0],
             power: self.coefficient * self.transverse_rate(&hub.omega).norm_squared(),
+            work: 0.0,
         }
     }
     fn telemetry_names(&self) -> Vec<String> {

@@ -6,12 +6,14 @@
 //! - [`WheelDamper`]: a viscous wheel damper about a body axis.
 //! - [`HingedRod`]: a rigid rod on a hinge with one or two rotational degrees of freedom.
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
+//! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //!
 //! The three mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
 
 pub mod beam;
 pub mod energy_sink;
+pub mod gravity_gradient;
 pub mod hinged_rod;
 pub mod modal;
 pub mod motion;
@@ -21,6 +23,7 @@ pub mod spring_mass;
 pub mod wheel;
 
 pub use energy_sink::EnergySink;
+pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};
 pub use modal::ModalBeam;
 pub use motion::SpinUp;

@@ -377,6 +377,7 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             elastic: self.model.elastic_energy(q),
             dissipated: x[2 * n],
             power: self.model.dissipation_power(q, u),
+            work: 0.0,
         }
     }
 

@@ -46,6 +46,9 @@ impl Effector for Rayleigh {
     fn is_external(&self) -> bool {
         true
     }
+    fn torque_only(&self) -> bool {
+        true
+    }
     fn couple(&self, hub: &HubState, _x: &[f64], c: &mut HubCoupling, _s: &mut [f64]) {
         c.add_torque(&(-(self.gamma * hub.omega)));
     }
@@ -64,6 +67,7 @@ impl Effector for Rayleigh {
             elastic: 0.0,
             dissipated: x[0],
             power: 2.0 * self.dissipation_function(&hub.omega),
+            work: 0.0,
         }
     }
     fn telemetry_names(&self) -> Vec<String> {

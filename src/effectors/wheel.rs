@@ -87,6 +87,7 @@ impl Effector for WheelDamper {
             elastic: 0.0,
             dissipated: x[1],
             power: self.damping * x[0] * x[0],
+            work: 0.0,
         }
     }
     fn telemetry_names(&self) -> Vec<String> {

@@ -179,6 +179,27 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("wheel_damper", "rate") => {
             return fixed("Rotor rate about its axis relative to the body", "rad/s");
         }
+        ("gravity_gradient", "torque_x") => {
+            return fixed("Gravity-gradient torque on the hub, body x", "N m");
+        }
+        ("gravity_gradient", "torque_y") => {
+            return fixed("Gravity-gradient torque on the hub, body y", "N m");
+        }
+        ("gravity_gradient", "torque_z") => {
+            return fixed("Gravity-gradient torque on the hub, body z", "N m");
+        }
+        ("gravity_gradient", "work") => {
+            return fixed(
+                "Work done by the gravity-gradient torque since the start",
+                "J",
+            );
+        }
+        ("gravity_gradient", "potential_energy") => {
+            return fixed(
+                "Attitude-dependent gravitational potential energy of the hub",
+                "J",
+            );
+        }
         _ => {}
     }
     if kind == "modal_appendage" {

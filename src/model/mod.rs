@@ -112,6 +112,9 @@ pub struct EnergyAccount {
     pub elastic: f64,
     /// Energy dissipated since t = 0 (J): an integrated bookkeeping state.
     pub dissipated: f64,
+    /// Work done on the spacecraft by an external torque since t = 0 (J): an integrated
+    /// bookkeeping state (environmental torques). The energy balance subtracts it.
+    pub work: f64,
     /// Present dissipation rate (W, ≥ 0).
     pub power: f64,
 }
@@ -198,6 +201,12 @@ pub trait Effector: Debug + Send + Sync {
     }
     /// Whether it applies an external torque (then H is not conserved).
     fn is_external(&self) -> bool {
+        false
+    }
+    /// Whether its [`Effector::couple`] only adds a torque: nothing in the mass matrix, no
+    /// translation. A scene of such effectors solves the hub with its constant inverse
+    /// inertia instead of the general coupled system.
+    fn torque_only(&self) -> bool {
         false
     }
     /// Length of the scratch space `couple` may fill for `derivatives` (numbers).
@@ -294,6 +303,8 @@ pub struct Spacecraft {
     scratch_offsets: Vec<usize>,
     scratch_len: usize,
     translation: bool,
+    /// Every effector is [`Effector::torque_only`] (and there is at least one).
+    torque_only: bool,
     dim: usize,
 }
 
@@ -317,6 +328,7 @@ impl Spacecraft {
             scratch_offsets: Vec::new(),
             scratch_len: 0,
             translation: false,
+            torque_only: false,
             dim: HUB_STATES,
         }
     }
@@ -340,6 +352,8 @@ impl Spacecraft {
             }
             self.translation = true;
         }
+        self.torque_only =
+            effector.torque_only() && (self.effectors.is_empty() || self.torque_only);
         self.offsets.push(self.dim);
         self.dim += effector.num_states();
         self.scratch_offsets.push(self.scratch_len);
@@ -474,12 +488,15 @@ impl Spacecraft {
     fn coupling(&self, hub: &HubState, y: &[f64], scratch: &mut [f64]) -> HubCoupling {
         let omega = hub.omega;
         let mut mass = Matrix6::zeros();
-        let m = self.hub_mass.unwrap_or(1.0);
-        for i in 0..3 {
-            mass[(i, i)] = m;
+        // Torque-only scenes never read the mass matrix (see `rhs`).
+        if !self.torque_only {
+            let m = self.hub_mass.unwrap_or(1.0);
+            for i in 0..3 {
+                mass[(i, i)] = m;
+            }
+            mass.fixed_view_mut::<3, 3>(3, 3)
+                .copy_from(&self.hub.inertia);
         }
-        mass.fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&self.hub.inertia);
         let gyro = -omega.cross(&(self.hub.inertia * omega));
         let mut coupling = HubCoupling {
             mass,
@@ -677,6 +694,14 @@ impl OdeSystem for Spacecraft {
         let omega = Vector3::new(y[0], y[1], y[2]);
         let omega_dot = if self.effectors.is_empty() {
             self.rigid_omega_dot(&omega)
+        } else if self.torque_only {
+            // I ω̇ = −ω × Iω + Σ τ: the inverse inertia is constant (the same inverse the
+            // general solve computes from the same matrix, so the results are identical).
+            let inverse = &self.hub.inertia_inv;
+            self.effector_rhs(t, y, dydt, |c| HubAcceleration {
+                linear: Vector3::zeros(),
+                angular: inverse * Vector3::new(c.force[3], c.force[4], c.force[5]),
+            })
         } else {
             self.effector_rhs(t, y, dydt, solve_hub)
         };

@@ -28,6 +28,8 @@ pub struct Observation {
     pub dissipated_energy: f64,
     /// Present total dissipation rate (W).
     pub dissipation_power: f64,
+    /// Work done on the spacecraft by external (environmental) torques since t = 0 (J).
+    pub external_work: f64,
     /// Angle between the scenario's spin axis and H (rad).
     pub nutation_angle: f64,
     /// Angle between ω and each principal axis of the hub, in principal order (rad, [0, π]).
@@ -35,9 +37,10 @@ pub struct Observation {
 }
 
 impl Observation {
-    /// Kinetic + elastic + dissipated energy (J): constant for a free spacecraft.
+    /// Kinetic + elastic + dissipated energy minus the work of external torques (J):
+    /// constant for any spacecraft without a prescribed motion (work–energy theorem).
     pub fn energy_balance(&self) -> f64 {
-        self.kinetic_energy + self.elastic_energy + self.dissipated_energy
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - self.external_work
     }
 }
 
@@ -61,14 +64,16 @@ pub struct Invariants {
     pub dissipated_energy: f64,
     /// Present dissipation rate (W).
     pub dissipation_power: f64,
+    /// Work of external torques (J).
+    pub external_work: f64,
     /// `|q| − 1`.
     pub q_norm_error: f64,
 }
 
 impl Invariants {
-    /// Kinetic + elastic + dissipated energy (J).
+    /// Kinetic + elastic + dissipated energy minus the work of external torques (J).
     pub fn energy_balance(&self) -> f64 {
-        self.kinetic_energy + self.elastic_energy + self.dissipated_energy
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - self.external_work
     }
 }
 
@@ -80,6 +85,7 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
     let mut h_body = sc.hub.inertia * omega;
     let mut kinetic_energy = 0.5 * omega.dot(&(sc.hub.inertia * omega));
     let (mut elastic_energy, mut dissipated_energy, mut dissipation_power) = (0.0, 0.0, 0.0);
+    let mut external_work = 0.0;
     if !sc.effectors().is_empty() {
         let hub = HubState {
             t,
@@ -101,6 +107,7 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
             elastic_energy += a.elastic;
             dissipated_energy += a.dissipated;
             dissipation_power += a.power;
+            external_work += a.work;
         }
         // The system's linear momentum is zero, so the hub moves at v_B = −P_rel / M; that
         // adds S × v_B to H and −½ |P_rel|² / M to T (values about the system centre of mass).
@@ -118,6 +125,7 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
         elastic_energy,
         dissipated_energy,
         dissipation_power,
+        external_work,
         q_norm_error: q_norm - 1.0,
     };
     (inv, attitude)
@@ -140,6 +148,7 @@ pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64]) -> Observation {
         elastic_energy: inv.elastic_energy,
         dissipated_energy: inv.dissipated_energy,
         dissipation_power: inv.dissipation_power,
+        external_work: inv.external_work,
         nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
         angles_to_principal,
     }

@@ -256,6 +256,22 @@ impl Orbit {
         (r, v)
     }
 
+    /// The unit vector from the body's centre to the spacecraft (ECI) and the distance (m) at
+    /// time t: what the environment torques need, without the velocity. Equal to
+    /// [`Orbit::state`]'s position over its norm.
+    #[inline]
+    pub fn direction(&self, t: f64) -> (Vector3<f64>, f64) {
+        let ph = self.phase(t);
+        let (a, e) = (self.elements.semi_major_axis, self.elements.eccentricity);
+        let [p, q, _] = ph.axes;
+        if e == 0.0 {
+            // Circular: r = a, and the position is a (P̂ cos E + Q̂ sin E) exactly.
+            return (p * ph.cos_e + q * ph.sin_e, a);
+        }
+        let r = p * (a * (ph.cos_e - e)) + q * (self.b * ph.sin_e);
+        (r / ph.r, ph.r)
+    }
+
     /// Distance from the body's centre (m).
     pub fn radius(&self, t: f64) -> f64 {
         self.phase(t).r

@@ -31,6 +31,18 @@ pub enum EffectorSpec {
     HingedRod(HingedRodSpec),
     /// Modal cantilever beam.
     ModalAppendage(ModalSpec),
+    /// Gravity-gradient torque of the central body (needs `orbit:`).
+    GravityGradient(GravityGradientSpec),
+}
+
+/// `gravity_gradient:` — no parameters beyond a name: the hub's inertia and the orbit give
+/// the torque.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravityGradientSpec {
+    /// Name (default `gravity_gradient`).
+    #[serde(default)]
+    pub name: Option<String>,
 }
 
 /// `rayleigh:`.
@@ -440,6 +452,8 @@ pub(super) struct Context<'a> {
     pub shift: Vector3<f64>,
     /// Located warnings (placements that could not be checked).
     pub notes: std::cell::RefCell<Vec<ScenarioError>>,
+    /// The orbit (`orbit:`), which environmental effectors need.
+    pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -459,6 +473,7 @@ pub(super) fn build(
             EffectorSpec::WheelDamper(_) => "wheel_damper",
             EffectorSpec::HingedRod(_) => "hinged_rod",
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
+            EffectorSpec::GravityGradient(_) => "gravity_gradient",
         };
         let ck = Check {
             path: cx.path,
@@ -476,6 +491,23 @@ pub(super) fn build(
                 })
         };
         match spec {
+            EffectorSpec::GravityGradient(g) => {
+                let Some(orbit) = &cx.orbit else {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        item,
+                        ck.prefix.clone(),
+                        "an environmental torque needs the spacecraft's orbit: add an \
+                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
+                         inclination_deg, …)",
+                    ));
+                };
+                out.push(Box::new(crate::effectors::GravityGradient {
+                    name: name_of(&g.name),
+                    orbit: orbit.clone(),
+                    inertia: cx.hub.inertia,
+                }));
+            }
             EffectorSpec::Rayleigh(r) => {
                 let gamma = match (&r.gamma, &r.gamma_diagonal) {
                     (Some(g), None) => {
@@ -745,6 +777,26 @@ pub(super) fn build(
                 }
             }
         }
+    }
+    // The gravity gradient acts on the hub's inertia only: on moving masses it would need
+    // each particle's tidal force, which is not modelled yet.
+    if let Some(i) = specs
+        .iter()
+        .position(|s| matches!(s.value, EffectorSpec::GravityGradient(_)))
+        && let Some(mover) = out.iter().find(|e| e.moves_mass())
+    {
+        return Err(ScenarioError::at(
+            cx.path,
+            loc(&specs[i]),
+            format!("effectors[{i}].gravity_gradient"),
+            format!(
+                "the gravity-gradient torque is modelled on the rigid hub only, and `{}` moves \
+                 mass relative to it (the tidal force on each moving particle is not modelled \
+                 yet): use `body.composite` mass properties with a torque-only scene, or leave \
+                 the gravity gradient out",
+                mover.name()
+            ),
+        ));
     }
     // The energy sink is the quasi-rigid model: its Ĥ is the hub's Iω, so it keeps |H| only
     // when no other effector carries momentum.

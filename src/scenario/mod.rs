@@ -7,6 +7,7 @@
 
 mod effectors;
 mod error;
+mod orbit;
 mod time;
 
 pub use effectors::{EffectorSpec, HubMotionSpec};
@@ -91,6 +92,9 @@ pub struct ScenarioFile {
     /// Bounds on invariant drift and what to do when one is exceeded.
     #[serde(default)]
     pub checks: Option<ChecksSpec>,
+    /// The orbit of the spacecraft's centre of mass (environmental torques, LVLH).
+    #[serde(default)]
+    pub orbit: Option<orbit::OrbitSpec>,
 }
 
 /// `checks:` — accuracy the run must keep, checked at every step.
@@ -211,9 +215,12 @@ pub struct InitialSpec {
     /// Body rates (rev/min), instead of `omega`.
     #[serde(default)]
     pub omega_rpm: Option<Spanned<[f64; 3]>>,
-    /// Attitude, body → inertial (default identity).
+    /// Attitude, body → inertial (default identity); body → LVLH with `frame: lvlh`.
     #[serde(default)]
     pub attitude: Option<Spanned<QuaternionSpec>>,
+    /// `inertial` (default) or `lvlh`: the frame `attitude` and the rates are relative to.
+    #[serde(default)]
+    pub frame: Option<Spanned<String>>,
 }
 
 /// A quaternion by named components (scalar `w`).
@@ -648,6 +655,8 @@ pub struct Scenario {
     pub drift_limits: DriftLimits,
     /// Largest log the run may write (MB), checked against an estimate before it starts.
     pub max_log_mb: f64,
+    /// The orbit (`orbit:`), when the scenario has one.
+    pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
 }
 
 /// Overrides from the command line, applied before validation.
@@ -1260,6 +1269,21 @@ impl ScenarioFile {
             }
         };
 
+        // The orbit, and the initial state given relative to its LVLH frame.
+        let orbit = match &self.orbit {
+            Some(spec) => Some(orbit::orbit(path, spec, key_location(&source, "orbit"))?),
+            None => None,
+        };
+        let frame = orbit::initial_frame(path, &self.initial.frame, orbit.is_some())?;
+        let (attitude0, omega0) = match (&orbit, frame) {
+            (Some(o), orbit::InitialFrame::Lvlh) => orbit::from_lvlh(o, &attitude0, &omega0),
+            _ => (attitude0, omega0),
+        };
+        if frame == orbit::InitialFrame::Lvlh {
+            check_rate(&omega0)
+                .map_err(|m| err(loc_of(&self.initial.frame), "initial.frame", m))?;
+        }
+
         // Spin axis: given, or the principal axis closest to the initial angular momentum.
         let spin_axis = match &self.body.spin_axis {
             Some(s) => {
@@ -1671,6 +1695,7 @@ impl ScenarioFile {
             omega0,
             shift: Vector3::zeros(),
             notes: std::cell::RefCell::new(Vec::new()),
+            orbit: orbit.clone(),
         };
         let mut built = effectors::build(&cx, &self.effectors)?;
         let mut warnings = cx.notes.into_inner();
@@ -1699,6 +1724,7 @@ impl ScenarioFile {
                         omega0,
                         shift: -offset,
                         notes: std::cell::RefCell::new(Vec::new()),
+                        orbit: orbit.clone(),
                     };
                     built = effectors::build(&cx, &self.effectors)?;
                     warnings = cx.notes.into_inner();
@@ -1843,6 +1869,7 @@ impl ScenarioFile {
             montecarlo: self.montecarlo,
             drift_limits,
             max_log_mb,
+            orbit,
         })
     }
 }

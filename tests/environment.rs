@@ -1,0 +1,320 @@
+//! A spacecraft in orbit: the LVLH initial frame and the gravity-gradient torque, checked
+//! against what polhode did not produce — the small-angle pitch libration frequency of the
+//! linearised equations, an independent integration of the large-angle pitch pendulum, the
+//! Jacobi integral of a circular orbit, the work–energy balance — and the located errors.
+
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+use polhode::model::Observation;
+use polhode::scenario::{Overrides, Scenario, parse};
+use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Status};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+#[derive(Default)]
+struct Recorder {
+    samples: Vec<(f64, Vec<f64>, f64)>,
+}
+
+impl Sink for Recorder {
+    fn sample(&mut self, o: &Observation, y: &[f64], _: &Reference) -> std::io::Result<()> {
+        self.samples.push((o.t, y.to_vec(), o.energy_balance()));
+        Ok(())
+    }
+    fn event(&mut self, _: &EventRecord, _: &Observation) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+fn load(yaml: &str) -> Scenario {
+    parse(
+        Path::new("env.yaml"),
+        yaml.to_string(),
+        &Overrides::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn run(s: &Scenario) -> (Outcome, Recorder) {
+    let mut rec = Recorder::default();
+    let stop = AtomicBool::new(false);
+    let out = sim::run(
+        s,
+        &mut rec,
+        Control {
+            interrupt: &stop,
+            progress: None,
+        },
+    )
+    .unwrap();
+    (out, rec)
+}
+
+/// Earth's μ (m³/s², WGS-84) and the orbit radius used below (m): a 600 km circular orbit.
+const MU: f64 = 3.986_004_418e14;
+const RADIUS: f64 = 6_978_137.0;
+
+fn mean_motion() -> f64 {
+    (MU / RADIUS.powi(3)).sqrt()
+}
+
+/// A rigid body with principal moments `i` in a circular equatorial orbit at 600 km, started
+/// at `attitude` relative to LVLH (w, x, y, z) at rest in LVLH, with the gravity gradient.
+fn scene(i: [f64; 3], attitude: [f64; 4], orbits: f64, rtol: f64) -> String {
+    let period = 2.0 * std::f64::consts::PI / mean_motion();
+    format!(
+        "name: gg
+body: {{principal: [{}, {}, {}]}}
+orbit: {{semi_major_axis_km: {}, inclination_deg: 0.0}}
+initial:
+  frame: lvlh
+  omega: [0.0, 0.0, 0.0]
+  attitude: {{w: {}, x: {}, y: {}, z: {}}}
+duration: {}
+integrator: {{method: dop853, rtol: {rtol:e}, atol: 1.0e-16}}
+output: {{rate: 0.2}}
+effectors:
+  - gravity_gradient: {{}}
+",
+        i[0],
+        i[1],
+        i[2],
+        RADIUS / 1e3,
+        attitude[0],
+        attitude[1],
+        attitude[2],
+        attitude[3],
+        orbits * period
+    )
+}
+
+/// The LVLH frame of the circular equatorial orbit at t, computed here from its definition
+/// (o3 nadir, o2 = −orbit normal, o1 = o2 × o3): the orbit starts on the x axis and moves
+/// toward +y, so r = R (cos nt, sin nt, 0), ĥ = +z.
+fn lvlh_to_eci(t: f64) -> UnitQuaternion<f64> {
+    let nt = mean_motion() * t;
+    let r_hat = Vector3::new(nt.cos(), nt.sin(), 0.0);
+    let o3 = -r_hat;
+    let o2 = -Vector3::z();
+    let o1 = o2.cross(&o3);
+    let m = nalgebra::Matrix3::from_columns(&[o1, o2, o3]);
+    UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m))
+}
+
+/// The body attitude relative to LVLH at sample `y` (time `t`).
+fn relative_attitude(t: f64, y: &[f64]) -> UnitQuaternion<f64> {
+    let q_nb = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
+    lvlh_to_eci(t).inverse() * q_nb
+}
+
+/// Pitch (rotation about o2, rad) of a body that only pitches: 2·atan2(q_y, q_w), with the
+/// quaternion's sign chosen so that w ≥ 0 (q and −q are the same rotation).
+fn pitch(q: &UnitQuaternion<f64>) -> f64 {
+    let sign = if q.w < 0.0 { -1.0 } else { 1.0 };
+    2.0 * (sign * q.j).atan2(sign * q.w)
+}
+
+/// Times of the upward zero crossings of a sampled signal, by linear interpolation.
+fn upward_crossings(series: &[(f64, f64)]) -> Vec<f64> {
+    series
+        .windows(2)
+        .filter(|w| w[0].1 < 0.0 && w[1].1 >= 0.0)
+        .map(|w| w[0].0 + (w[1].0 - w[0].0) * (-w[0].1) / (w[1].1 - w[0].1))
+        .collect()
+}
+
+/// Small pitch librations of a body in the Lagrange region (I_y > I_x > I_z, principal axes
+/// on LVLH) have the frequency n √(3 (I_x − I_z)/I_y) of the linearised pitch equation
+/// θ̈ + 3n²k_P θ = 0 (Hughes 1986, §9.2; Kaplan 1976, §5.1).
+#[test]
+fn small_pitch_librations_have_the_linear_frequency() {
+    let i = [6.0, 8.0, 2.0];
+    let half = 0.05_f64.to_radians(); // 0.1° pitch about o2 (body y)
+    let yaml = scene(i, [half.cos(), 0.0, half.sin(), 0.0], 5.0, 1e-12);
+    let s = load(&yaml);
+    let (out, rec) = run(&s);
+    assert_eq!(out.status, Status::Complete);
+    let series: Vec<(f64, f64)> = rec
+        .samples
+        .iter()
+        .map(|(t, y, _)| (*t, pitch(&relative_attitude(*t, y))))
+        .collect();
+    // Roll and yaw stay at zero (pitch decouples).
+    for (t, y, _) in &rec.samples {
+        let q = relative_attitude(*t, y);
+        assert!(q.i.abs() < 1e-9 && q.k.abs() < 1e-9, "t = {t}: {q:?}");
+    }
+    let crossings = upward_crossings(&series);
+    assert!(crossings.len() >= 5, "{crossings:?}");
+    let measured = 2.0 * std::f64::consts::PI * (crossings.len() - 1) as f64
+        / (crossings[crossings.len() - 1] - crossings[0]);
+    let k_p = (i[0] - i[2]) / i[1];
+    let expected = mean_motion() * (3.0 * k_p).sqrt();
+    // The amplitude θ₀ lowers the frequency by θ₀²/4 relative (the pendulum's sin θ cos θ
+    // ≈ θ − ⅔θ³, a softening Duffing term): 7.6e-7 at 0.1° (7.6e-5 at 1°, which this test
+    // measured). The interpolated crossings of 5 s samples are good to ~1e-7 of a period.
+    let rel = (measured - expected).abs() / expected;
+    assert!(
+        rel < 5e-6,
+        "measured {measured:.9e}, expected {expected:.9e} (rel {rel:.2e})"
+    );
+}
+
+/// Large pitch angles against an independent integration of the planar pitch pendulum
+/// θ̈ = −3n²k_P sin θ cos θ (classical RK4, fixed step, written here).
+#[test]
+fn large_pitch_angles_follow_the_pitch_pendulum() {
+    let i = [6.0, 8.0, 2.0];
+    let theta0 = 60f64.to_radians();
+    let yaml = scene(
+        i,
+        [(0.5 * theta0).cos(), 0.0, (0.5 * theta0).sin(), 0.0],
+        2.0,
+        1e-12,
+    );
+    let s = load(&yaml);
+    let (out, rec) = run(&s);
+    assert_eq!(out.status, Status::Complete);
+    let k = 3.0 * mean_motion().powi(2) * (i[0] - i[2]) / i[1];
+    let f = |th: f64, _w: f64| -k * th.sin() * th.cos();
+    let h = 0.05;
+    let (mut th, mut w, mut steps) = (theta0, 0.0, 0u64);
+    let mut worst: f64 = 0.0;
+    for (ts, y, _) in &rec.samples {
+        // Whole steps of h up to the sample (counted, so no rounding drift in t).
+        while ((steps + 1) as f64) * h <= *ts + 1e-9 {
+            let (k1t, k1w) = (w, f(th, w));
+            let (k2t, k2w) = (w + 0.5 * h * k1w, f(th + 0.5 * h * k1t, 0.0));
+            let (k3t, k3w) = (w + 0.5 * h * k2w, f(th + 0.5 * h * k2t, 0.0));
+            let (k4t, k4w) = (w + h * k3w, f(th + h * k3t, 0.0));
+            th += h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t);
+            w += h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w);
+            steps += 1;
+        }
+        if (steps as f64 * h - ts).abs() > 1e-9 {
+            continue; // the final instant is off the step grid
+        }
+        let polhode = pitch(&relative_attitude(*ts, y));
+        worst = worst.max((polhode - th).abs());
+    }
+    // RK4 at h = 0.05 s on a motion of period ~3400 s: error ~1e-12 rad.
+    assert!(worst < 1e-7, "largest pitch difference {worst:e} rad");
+}
+
+/// In a circular orbit with gravity gradient only, the Jacobi integral
+/// h = ½ ω_rᵀ I ω_r − (n²/2) ĉ₂ᵀ I ĉ₂ + (3n²/2) ĉ₃ᵀ I ĉ₃ is conserved (ω_r the rate relative
+/// to LVLH, ĉ₂ and ĉ₃ the orbit normal and nadir in body axes; Hughes 1986, §9.3). Tumbling in
+/// all three axes; and the energy balance T − W (work of the torque) holds too.
+#[test]
+fn the_jacobi_integral_is_conserved_in_a_circular_orbit() {
+    let i = [3.0, 5.0, 7.0];
+    let q = UnitQuaternion::from_euler_angles(0.4, -0.3, 1.1);
+    let mut yaml = scene(i, [q.w, q.i, q.j, q.k], 3.0, 1e-12);
+    yaml = yaml.replace("omega: [0.0, 0.0, 0.0]", "omega: [0.002, -0.001, 0.003]");
+    let s = load(&yaml);
+    let (out, rec) = run(&s);
+    assert_eq!(out.status, Status::Complete);
+    let n = mean_motion();
+    let inertia = nalgebra::Matrix3::from_diagonal(&Vector3::from(i));
+    let jacobi = |t: f64, y: &[f64]| {
+        let q_nb = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
+        let frame = lvlh_to_eci(t);
+        let omega_on = frame * Vector3::new(0.0, -n, 0.0); // n ĥ = −n o2
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let omega_r = omega - q_nb.inverse_transform_vector(&omega_on);
+        let c2 = q_nb.inverse_transform_vector(&(frame * Vector3::y()));
+        let c3 = q_nb.inverse_transform_vector(&(frame * Vector3::z()));
+        0.5 * omega_r.dot(&(inertia * omega_r)) - 0.5 * n * n * c2.dot(&(inertia * c2))
+            + 1.5 * n * n * c3.dot(&(inertia * c3))
+    };
+    let (t0, y0, e0) = &rec.samples[0];
+    let h0 = jacobi(*t0, y0);
+    let scale = 0.5 * 7.0 * 0.004f64.powi(2) + 1.5 * n * n * 7.0;
+    let mut worst: f64 = 0.0;
+    let mut worst_energy: f64 = 0.0;
+    for (t, y, e) in &rec.samples {
+        worst = worst.max((jacobi(*t, y) - h0).abs() / scale);
+        worst_energy = worst_energy.max((e - e0).abs() / scale);
+    }
+    assert!(worst < 1e-9, "Jacobi integral drift {worst:e} (relative)");
+    assert!(
+        worst_energy < 1e-9,
+        "energy balance drift {worst_energy:e} (relative)"
+    );
+    // The torque does work: the kinetic energy itself changes by much more than that.
+    let ke: Vec<f64> = rec
+        .samples
+        .iter()
+        .map(|(_, y, _)| {
+            let w = Vector3::new(y[0], y[1], y[2]);
+            0.5 * w.dot(&(inertia * w))
+        })
+        .collect();
+    let spread =
+        ke.iter().cloned().fold(f64::MIN, f64::max) - ke.iter().cloned().fold(f64::MAX, f64::min);
+    assert!(spread / scale > 1e-3, "T spread {spread:e}");
+}
+
+/// `initial.frame: lvlh` maps the attitude body → LVLH and adds the frame's rate: a body at
+/// rest in LVLH turns once per orbit about the orbit normal in inertial space.
+#[test]
+fn the_lvlh_initial_frame_adds_the_orbit_rate() {
+    let yaml = scene([6.0, 8.0, 2.0], [1.0, 0.0, 0.0, 0.0], 0.1, 1e-10);
+    let s = load(&yaml);
+    let n = mean_motion();
+    // Body axes on LVLH: ω_BN = ω_ON in body axes = −n ŷ_body (o2 = −ĥ).
+    assert!(
+        (s.omega0 - Vector3::new(0.0, -n, 0.0)).norm() < 1e-15 * n.max(1.0),
+        "{:?}",
+        s.omega0
+    );
+    let expected = lvlh_to_eci(0.0);
+    assert!(s.attitude0.angle_to(&expected) < 1e-14, "{:?}", s.attitude0);
+}
+
+/// Bad orbits and misplaced environment effectors are located errors.
+#[test]
+fn bad_orbits_are_refused_with_located_errors() {
+    let base =
+        "name: x\nbody: {principal: [1, 2, 3]}\ninitial: {omega: [0, 0, 0.1]}\nduration: 1\n";
+    let cases = [
+        (
+            format!("{base}orbit: {{semi_major_axis_km: 7000, eccentricity: 1.2}}\n"),
+            "env.yaml:5:49: field `orbit.eccentricity`: eccentricity 1.2: polhode propagates closed orbits: 0 ≤ e < 1",
+        ),
+        (
+            format!("{base}orbit: {{perigee_altitude_km: -50, apogee_altitude_km: 800}}\n"),
+            "field `orbit.perigee_altitude_km`: perigee altitude -50.000 km",
+        ),
+        (
+            format!("{base}orbit: {{central_body: mars, semi_major_axis_km: 7000}}\n"),
+            "field `orbit.central_body`",
+        ),
+        (
+            format!("{base}orbit: {{semi_major_axis_km: .nan}}\n"),
+            "field `orbit.semi_major_axis_km`: expected a finite number",
+        ),
+        (
+            format!("{base}effectors:\n  - gravity_gradient: {{}}\n"),
+            "env.yaml:6:5: field `effectors[0].gravity_gradient`: an environmental torque needs the spacecraft's orbit",
+        ),
+        (
+            base.replace(
+                "initial: {omega: [0, 0, 0.1]}",
+                "initial: {omega: [0, 0, 0.1], frame: lvlh}",
+            ),
+            "field `initial.frame`: `lvlh` is the orbit frame, so it needs an `orbit:` block",
+        ),
+        (
+            format!(
+                "{base}orbit: {{semi_major_axis_km: 7000, eccentricity: 0.1, perigee_altitude_km: 500, apogee_altitude_km: 600}}\n"
+            ),
+            "field `orbit.semi_major_axis_km`: expected the orbit's size",
+        ),
+    ];
+    for (yaml, expect) in cases {
+        let e = parse(Path::new("env.yaml"), yaml.clone(), &Overrides::default())
+            .expect_err(&yaml)
+            .to_string();
+        assert!(e.contains(expect), "expected {expect:?} in {e}\n{yaml}");
+    }
+}
