@@ -59,6 +59,9 @@ impl Effector for EnergySink {
     fn torque_only(&self) -> bool {
         true
     }
+    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
+        -self.coefficient * self.transverse_rate(&hub.omega)
+    }
     fn couple(&self, hub: &HubState, _x: &[f64], c: &mut HubCoupling, _s: &mut [f64]) {
         c.add_torque(&(-self.coefficient * self.transverse_rate(&hub.omega)));
     }

@@ -93,6 +93,9 @@ impl Effector for GravityGradient {
     fn torque_only(&self) -> bool {
         true
     }
+    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
+        GravityGradient::torque(self, hub.t, hub.attitude)
+    }
     fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
         let tau = self.torque(hub.t, hub.attitude);
         coupling.add_torque(&tau);

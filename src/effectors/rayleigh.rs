@@ -6,7 +6,7 @@
 //! bookkeeping state, the dissipated energy (Ẇ = 2R), closes the energy balance T + W = T₀.
 
 use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
-use nalgebra::Matrix3;
+use nalgebra::{Matrix3, Vector3};
 
 /// Rayleigh dissipation torque.
 #[derive(Debug, Clone)]
@@ -48,6 +48,9 @@ impl Effector for Rayleigh {
     }
     fn torque_only(&self) -> bool {
         true
+    }
+    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
+        -(self.gamma * hub.omega)
     }
     fn couple(&self, hub: &HubState, _x: &[f64], c: &mut HubCoupling, _s: &mut [f64]) {
         c.add_torque(&(-(self.gamma * hub.omega)));

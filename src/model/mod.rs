@@ -28,6 +28,10 @@ use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 use std::cell::RefCell;
 use std::fmt::Debug;
 
+/// Largest number of torque-only effectors the lean right-hand side takes (more go through
+/// the general hub coupling).
+const MAX_FAST_TORQUES: usize = 4;
+
 /// Number of hub states: ω (3) and q (4).
 pub const HUB_STATES: usize = 7;
 
@@ -208,6 +212,20 @@ pub trait Effector: Debug + Send + Sync {
     /// inertia instead of the general coupled system.
     fn torque_only(&self) -> bool {
         false
+    }
+    /// A torque-only effector's torque on the hub (N m, body axes) at the hub state and its
+    /// states `x`: what its [`Effector::couple`] adds. Torque-only scenes call this instead of
+    /// `couple`, then [`Effector::derivatives`] with the torque as the scratch space (length 3
+    /// when [`Effector::scratch_len`] asks for any). The default goes through `couple`.
+    fn torque(&self, hub: &HubState, x: &[f64]) -> Vector3<f64> {
+        let mut coupling = HubCoupling {
+            mass: Matrix6::zeros(),
+            force: Vector6::zeros(),
+            translation: false,
+        };
+        let mut scratch = vec![0.0; self.scratch_len()];
+        self.couple(hub, x, &mut coupling, &mut scratch);
+        Vector3::new(coupling.force[3], coupling.force[4], coupling.force[5])
     }
     /// Length of the scratch space `couple` may fill for `derivatives` (numbers).
     fn scratch_len(&self) -> usize {
@@ -516,6 +534,44 @@ impl Spacecraft {
         coupling
     }
 
+    /// Right-hand side of a scene whose effectors only apply torques (at most
+    /// [`MAX_FAST_TORQUES`]): I ω̇ = −ω × Iω + Σ τ with the constant inverse inertia, each
+    /// torque computed once by [`Effector::torque`] and handed to its `derivatives` as the
+    /// scratch; no hub coupling, no thread-local scratch. Returns ω̇.
+    #[inline(always)]
+    fn torque_rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) -> Vector3<f64> {
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let hub = HubState {
+            t,
+            omega,
+            attitude: &y[3..7],
+        };
+        let mut torques = [Vector3::zeros(); MAX_FAST_TORQUES];
+        let mut total = -omega.cross(&(self.hub.inertia * omega));
+        for (k, e) in self.effectors.iter().enumerate() {
+            let off = self.offsets[k];
+            torques[k] = e.torque(&hub, &y[off..off + e.num_states()]);
+            total += torques[k];
+        }
+        let accel = HubAcceleration {
+            linear: Vector3::zeros(),
+            angular: self.hub.inertia_inv * total,
+        };
+        for (k, e) in self.effectors.iter().enumerate() {
+            let off = self.offsets[k];
+            let n = e.num_states();
+            let scratch = &torques[k].as_slice()[..e.scratch_len().min(3)];
+            e.derivatives(
+                &hub,
+                &accel,
+                &y[off..off + n],
+                scratch,
+                &mut dydt[off..off + n],
+            );
+        }
+        accel.angular
+    }
+
     /// Right-hand side with the hub's accelerations taken from `solve(coupling)`.
     #[inline(always)]
     fn effector_rhs(
@@ -694,6 +750,8 @@ impl OdeSystem for Spacecraft {
         let omega = Vector3::new(y[0], y[1], y[2]);
         let omega_dot = if self.effectors.is_empty() {
             self.rigid_omega_dot(&omega)
+        } else if self.torque_only && self.effectors.len() <= MAX_FAST_TORQUES {
+            self.torque_rhs(t, y, dydt)
         } else if self.torque_only {
             // I ω̇ = −ω × Iω + Σ τ: the inverse inertia is constant (the same inverse the
             // general solve computes from the same matrix, so the results are identical).
