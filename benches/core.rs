@@ -148,17 +148,6 @@ fn bench_effector_rhs(repeats: usize) {
     )
     .expect("scenario");
     let calls = 20_000;
-    fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
-        let sc = &s.spacecraft;
-        let y = sc.initial_state(&s.omega0, &s.attitude0);
-        let mut dy = vec![0.0; sc.dim()];
-        move || {
-            for _ in 0..calls {
-                sc.rhs(0.0, black_box(&y), &mut dy);
-                black_box(&dy);
-            }
-        }
-    }
     println!("\none right-hand-side evaluation, against the rigid body (7 states):");
     for file in [
         "wheel-damper",
@@ -189,6 +178,22 @@ fn bench_effector_rhs(repeats: usize) {
     }
 }
 
+/// `calls` right-hand-side evaluations of `s` at its initial state, at times spread by
+/// 0.37 s (the environment's orbit phase changes from call to call; time-independent scenes
+/// do not care).
+fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
+    use polhode::integrate::OdeSystem;
+    let sc = &s.spacecraft;
+    let y = sc.initial_state(&s.omega0, &s.attitude0);
+    let mut dy = vec![0.0; sc.dim()];
+    move || {
+        for k in 0..calls {
+            sc.rhs(black_box(k as f64 * 0.37), black_box(&y), &mut dy);
+            black_box(&dy);
+        }
+    }
+}
+
 /// What the gravity gradient adds to a rigid body's right-hand side, as a ratio in one run:
 /// the same body without and with it, in a circular orbit and in an eccentric one (where
 /// every call solves Kepler's equation at its own time; times spread over an orbit).
@@ -203,17 +208,6 @@ fn bench_environment_rhs(repeats: usize) {
         scenario::parse(Path::new("bench.yaml"), text, &Overrides::default()).expect("scenario")
     };
     let calls = 20_000;
-    fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
-        let sc = &s.spacecraft;
-        let y = sc.initial_state(&s.omega0, &s.attitude0);
-        let mut dy = vec![0.0; sc.dim()];
-        move || {
-            for k in 0..calls {
-                sc.rhs(black_box(k as f64 * 0.37), black_box(&y), &mut dy);
-                black_box(&dy);
-            }
-        }
-    }
     let rigid = load(yaml("", ""));
     println!(
         "\ntorque effectors (the machinery alone, then the gravity gradient), one \

@@ -3,51 +3,14 @@
 //! linearised equations, an independent integration of the large-angle pitch pendulum, the
 //! Jacobi integral of a circular orbit, the work–energy balance — and the located errors.
 
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+mod common;
+
+use common::{run, scenario as load};
+use nalgebra::{UnitQuaternion, Vector3};
 use polhode::model::Observation;
-use polhode::scenario::{Overrides, Scenario, parse};
-use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Status};
+use polhode::scenario::{Overrides, parse};
+use polhode::sim::Status;
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
-
-#[derive(Default)]
-struct Recorder {
-    samples: Vec<(f64, Vec<f64>, f64)>,
-}
-
-impl Sink for Recorder {
-    fn sample(&mut self, o: &Observation, y: &[f64], _: &Reference) -> std::io::Result<()> {
-        self.samples.push((o.t, y.to_vec(), o.energy_balance()));
-        Ok(())
-    }
-    fn event(&mut self, _: &EventRecord, _: &Observation) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
-fn load(yaml: &str) -> Scenario {
-    parse(
-        Path::new("env.yaml"),
-        yaml.to_string(),
-        &Overrides::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(s: &Scenario) -> (Outcome, Recorder) {
-    let mut rec = Recorder::default();
-    let stop = AtomicBool::new(false);
-    let out = sim::run(
-        s,
-        &mut rec,
-        Control {
-            interrupt: &stop,
-            progress: None,
-        },
-    )
-    .unwrap();
-    (out, rec)
-}
 
 /// Earth's μ (m³/s², WGS-84) and the orbit radius used below (m): a 600 km circular orbit.
 const MU: f64 = 3.986_004_418e14;
@@ -100,10 +63,9 @@ fn lvlh_to_eci(t: f64) -> UnitQuaternion<f64> {
     UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(m))
 }
 
-/// The body attitude relative to LVLH at sample `y` (time `t`).
-fn relative_attitude(t: f64, y: &[f64]) -> UnitQuaternion<f64> {
-    let q_nb = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
-    lvlh_to_eci(t).inverse() * q_nb
+/// The body attitude relative to LVLH at a sample.
+fn relative_attitude(o: &Observation) -> UnitQuaternion<f64> {
+    lvlh_to_eci(o.t).inverse() * o.attitude
 }
 
 /// Pitch (rotation about o2, rad) of a body that only pitches: 2·atan2(q_y, q_w), with the
@@ -136,12 +98,12 @@ fn small_pitch_librations_have_the_linear_frequency() {
     let series: Vec<(f64, f64)> = rec
         .samples
         .iter()
-        .map(|(t, y, _)| (*t, pitch(&relative_attitude(*t, y))))
+        .map(|o| (o.t, pitch(&relative_attitude(o))))
         .collect();
     // Roll and yaw stay at zero (pitch decouples).
-    for (t, y, _) in &rec.samples {
-        let q = relative_attitude(*t, y);
-        assert!(q.i.abs() < 1e-9 && q.k.abs() < 1e-9, "t = {t}: {q:?}");
+    for o in &rec.samples {
+        let q = relative_attitude(o);
+        assert!(q.i.abs() < 1e-9 && q.k.abs() < 1e-9, "t = {}: {q:?}", o.t);
     }
     let crossings = upward_crossings(&series);
     assert!(crossings.len() >= 5, "{crossings:?}");
@@ -179,7 +141,8 @@ fn large_pitch_angles_follow_the_pitch_pendulum() {
     let h = 0.05;
     let (mut th, mut w, mut steps) = (theta0, 0.0, 0u64);
     let mut worst: f64 = 0.0;
-    for (ts, y, _) in &rec.samples {
+    for o in &rec.samples {
+        let ts = &o.t;
         // Whole steps of h up to the sample (counted, so no rounding drift in t).
         while ((steps + 1) as f64) * h <= *ts + 1e-9 {
             let (k1t, k1w) = (w, f(th, w));
@@ -193,7 +156,7 @@ fn large_pitch_angles_follow_the_pitch_pendulum() {
         if (steps as f64 * h - ts).abs() > 1e-9 {
             continue; // the final instant is off the step grid
         }
-        let polhode = pitch(&relative_attitude(*ts, y));
+        let polhode = pitch(&relative_attitude(o));
         worst = worst.max((polhode - th).abs());
     }
     // RK4 at h = 0.05 s on a motion of period ~3400 s: error ~1e-12 rad.
@@ -215,25 +178,25 @@ fn the_jacobi_integral_is_conserved_in_a_circular_orbit() {
     assert_eq!(out.status, Status::Complete);
     let n = mean_motion();
     let inertia = nalgebra::Matrix3::from_diagonal(&Vector3::from(i));
-    let jacobi = |t: f64, y: &[f64]| {
-        let q_nb = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
-        let frame = lvlh_to_eci(t);
+    let jacobi = |o: &Observation| {
+        let q_nb = o.attitude;
+        let frame = lvlh_to_eci(o.t);
         let omega_on = frame * Vector3::new(0.0, -n, 0.0); // n ĥ = −n o2
-        let omega = Vector3::new(y[0], y[1], y[2]);
+        let omega = o.omega;
         let omega_r = omega - q_nb.inverse_transform_vector(&omega_on);
         let c2 = q_nb.inverse_transform_vector(&(frame * Vector3::y()));
         let c3 = q_nb.inverse_transform_vector(&(frame * Vector3::z()));
         0.5 * omega_r.dot(&(inertia * omega_r)) - 0.5 * n * n * c2.dot(&(inertia * c2))
             + 1.5 * n * n * c3.dot(&(inertia * c3))
     };
-    let (t0, y0, e0) = &rec.samples[0];
-    let h0 = jacobi(*t0, y0);
+    let first = &rec.samples[0];
+    let (h0, e0) = (jacobi(first), first.energy_balance());
     let scale = 0.5 * 7.0 * 0.004f64.powi(2) + 1.5 * n * n * 7.0;
     let mut worst: f64 = 0.0;
     let mut worst_energy: f64 = 0.0;
-    for (t, y, e) in &rec.samples {
-        worst = worst.max((jacobi(*t, y) - h0).abs() / scale);
-        worst_energy = worst_energy.max((e - e0).abs() / scale);
+    for o in &rec.samples {
+        worst = worst.max((jacobi(o) - h0).abs() / scale);
+        worst_energy = worst_energy.max((o.energy_balance() - e0).abs() / scale);
     }
     assert!(worst < 1e-9, "Jacobi integral drift {worst:e} (relative)");
     assert!(
@@ -244,10 +207,7 @@ fn the_jacobi_integral_is_conserved_in_a_circular_orbit() {
     let ke: Vec<f64> = rec
         .samples
         .iter()
-        .map(|(_, y, _)| {
-            let w = Vector3::new(y[0], y[1], y[2]);
-            0.5 * w.dot(&(inertia * w))
-        })
+        .map(|o| 0.5 * o.omega.dot(&(inertia * o.omega)))
         .collect();
     let spread =
         ke.iter().cloned().fold(f64::MIN, f64::max) - ke.iter().cloned().fold(f64::MAX, f64::min);
@@ -279,7 +239,7 @@ fn bad_orbits_are_refused_with_located_errors() {
     let cases = [
         (
             format!("{base}orbit: {{semi_major_axis_km: 7000, eccentricity: 1.2}}\n"),
-            "env.yaml:5:49: field `orbit.eccentricity`: eccentricity 1.2: polhode propagates closed orbits: 0 ≤ e < 1",
+            "test.yaml:5:49: field `orbit.eccentricity`: eccentricity 1.2: polhode propagates closed orbits: 0 ≤ e < 1",
         ),
         (
             format!("{base}orbit: {{perigee_altitude_km: -50, apogee_altitude_km: 800}}\n"),
@@ -295,7 +255,7 @@ fn bad_orbits_are_refused_with_located_errors() {
         ),
         (
             format!("{base}effectors:\n  - gravity_gradient: {{}}\n"),
-            "env.yaml:6:5: field `effectors[0].gravity_gradient`: an environmental torque needs the spacecraft's orbit",
+            "test.yaml:6:5: field `effectors[0].gravity_gradient`: an environmental torque needs the spacecraft's orbit",
         ),
         (
             base.replace(
@@ -312,7 +272,7 @@ fn bad_orbits_are_refused_with_located_errors() {
         ),
     ];
     for (yaml, expect) in cases {
-        let e = parse(Path::new("env.yaml"), yaml.clone(), &Overrides::default())
+        let e = parse(Path::new("test.yaml"), yaml.clone(), &Overrides::default())
             .expect_err(&yaml)
             .to_string();
         assert!(e.contains(expect), "expected {expect:?} in {e}\n{yaml}");
