@@ -198,7 +198,6 @@ fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
 /// the same body without and with it, in a circular orbit and in an eccentric one (where
 /// every call solves Kepler's equation at its own time; times spread over an orbit).
 fn bench_environment_rhs(repeats: usize) {
-    use polhode::integrate::OdeSystem;
     let yaml = |orbit: &str, effectors: &str| {
         format!(
             "name: b\nbody: {{principal: [3, 5, 7]}}\n{orbit}initial: {{omega: [0.01, 0.02, 0.03]}}\nduration: 1\n{effectors}"
