@@ -125,6 +125,7 @@ struct Obs {
     elastic_energy: f64,
     dissipated_energy: f64,
     dissipation_power: f64,
+    external_work: f64,
     nutation_angle: f64,
     angles_to_principal: [f64; 3],
 }
@@ -144,6 +145,7 @@ impl Obs {
             elastic_energy: self.elastic_energy,
             dissipated_energy: self.dissipated_energy,
             dissipation_power: self.dissipation_power,
+            external_work: self.external_work,
             nutation_angle: self.nutation_angle,
             angles_to_principal: self.angles_to_principal,
         }
