@@ -10,7 +10,12 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Every file under `dir`, recursively (symbolic links are not followed).
+/// Directories of installed third-party material (npm packages, Python environments, build
+/// output) that the viewer and reader scripts create next to their sources: not ours.
+const THIRD_PARTY_DIRS: [&str; 4] = ["node_modules", "target", "__pycache__", "site-packages"];
+
+/// Every file under `dir`, recursively (symbolic links are not followed), leaving out
+/// hidden directories (`.venv`, …) and [`THIRD_PARTY_DIRS`].
 fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = fs::read_dir(dir) else {
         return;
@@ -21,6 +26,11 @@ fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
             continue;
         };
         if kind.is_dir() {
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with('.') || THIRD_PARTY_DIRS.contains(&name.as_ref()) {
+                continue;
+            }
             files_under(&path, out);
         } else if kind.is_file() {
             out.push(path);
