@@ -1656,6 +1656,8 @@ const ALL_KEYS: &[&str] = &[
     "arg_perigee_deg",
     "true_anomaly_deg",
     "j2_secular",
+    "magnetic_dipole",
+    "moment",
 ];
 
 impl Valid {

@@ -7,6 +7,7 @@
 //! - [`HingedRod`]: a rigid rod on a hinge with one or two rotational degrees of freedom.
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
+//! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
 //!
 //! The three mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
@@ -15,6 +16,7 @@ pub mod beam;
 pub mod energy_sink;
 pub mod gravity_gradient;
 pub mod hinged_rod;
+pub mod magnetic_dipole;
 pub mod modal;
 pub mod motion;
 pub mod particles;
@@ -25,6 +27,7 @@ pub mod wheel;
 pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};
+pub use magnetic_dipole::MagneticDipole;
 pub use modal::ModalBeam;
 pub use motion::SpinUp;
 pub use particles::{ParticleEffector, ParticleModel};

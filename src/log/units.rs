@@ -200,6 +200,21 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
                 "J",
             );
         }
+        ("magnetic_dipole", "torque_x") => {
+            return fixed("Magnetic torque m × B on the hub, body x", "N m");
+        }
+        ("magnetic_dipole", "torque_y") => {
+            return fixed("Magnetic torque m × B on the hub, body y", "N m");
+        }
+        ("magnetic_dipole", "torque_z") => {
+            return fixed("Magnetic torque m × B on the hub, body z", "N m");
+        }
+        ("magnetic_dipole", "b_x") => return fixed("Geomagnetic field, body x", "T"),
+        ("magnetic_dipole", "b_y") => return fixed("Geomagnetic field, body y", "T"),
+        ("magnetic_dipole", "b_z") => return fixed("Geomagnetic field, body z", "T"),
+        ("magnetic_dipole", "work") => {
+            return fixed("Work done by the magnetic torque since the start", "J");
+        }
         _ => {}
     }
     if kind == "modal_appendage" {

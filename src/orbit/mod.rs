@@ -27,10 +27,12 @@ mod body;
 mod earth;
 mod elements;
 pub mod kepler;
+pub mod magnetic;
 
 pub use body::CentralBody;
 pub use earth::{earth_rotation_angle, gmst_iau82};
 pub use elements::Elements;
+pub use magnetic::GeomagneticField;
 
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use std::f64::consts::TAU;

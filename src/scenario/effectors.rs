@@ -33,7 +33,25 @@ pub enum EffectorSpec {
     ModalAppendage(ModalSpec),
     /// Gravity-gradient torque of the central body (needs `orbit:`).
     GravityGradient(GravityGradientSpec),
+    /// A constant magnetic dipole moment in the Earth's field (needs `orbit:`).
+    MagneticDipole(MagneticDipoleSpec),
 }
+
+/// `magnetic_dipole:` — a constant (residual) dipole moment on the hub in the first-degree
+/// IGRF field of the Earth.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MagneticDipoleSpec {
+    /// Name (default `magnetic_dipole`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The dipole moment (A m², body axes).
+    pub moment: Spanned<[f64; 3]>,
+}
+
+/// Largest magnitude of a `magnetic_dipole` moment (A m²): far above any spacecraft's
+/// magnetorquers (tens to hundreds of A m²).
+pub const MAX_DIPOLE_MOMENT: f64 = 1e4;
 
 /// `gravity_gradient:` — no parameters beyond a name: the hub's inertia and the orbit give
 /// the torque.
@@ -454,6 +472,10 @@ pub(super) struct Context<'a> {
     pub notes: std::cell::RefCell<Vec<ScenarioError>>,
     /// The orbit (`orbit:`), which environmental effectors need.
     pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
+    /// The scenario epoch (Unix ns, UTC) of simulation time 0, and where `epoch:` is written
+    /// (None for the default).
+    pub epoch_unix_ns: u64,
+    pub epoch_loc: Option<(u32, u32)>,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -474,6 +496,7 @@ pub(super) fn build(
             EffectorSpec::HingedRod(_) => "hinged_rod",
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
+            EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
         };
         let ck = Check {
             path: cx.path,
@@ -506,6 +529,56 @@ pub(super) fn build(
                     name: name_of(&g.name),
                     orbit: orbit.clone(),
                     inertia: cx.hub.inertia,
+                }));
+            }
+            EffectorSpec::MagneticDipole(m) => {
+                let Some(orbit) = &cx.orbit else {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        item,
+                        ck.prefix.clone(),
+                        "an environmental torque needs the spacecraft's orbit: add an \
+                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
+                         inclination_deg, …)",
+                    ));
+                };
+                let v = Vector3::from(m.moment.value);
+                if !v.iter().all(|c| c.is_finite()) || v.norm() > MAX_DIPOLE_MOMENT {
+                    return Err(ck.err(
+                        &m.moment,
+                        "moment",
+                        format!(
+                            "expected three finite numbers with magnitude at most \
+                             {MAX_DIPOLE_MOMENT:e} (A m², body axes), got [{}, {}, {}]",
+                            m.moment.value[0], m.moment.value[1], m.moment.value[2]
+                        ),
+                    ));
+                }
+                let field = crate::orbit::GeomagneticField::new(cx.epoch_unix_ns);
+                let year = field.year(0.0);
+                use crate::orbit::magnetic::{FIRST_YEAR, LAST_YEAR};
+                if !(FIRST_YEAR..=LAST_YEAR).contains(&year) {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        cx.epoch_loc.or(item),
+                        "epoch",
+                        format!(
+                            "the magnetic field model (IGRF-14 dipole) covers {FIRST_YEAR} to \
+                             {LAST_YEAR}, and the epoch is {year:.2}{}: choose an epoch in \
+                             that range",
+                            if cx.epoch_loc.is_none() {
+                                " (the default)"
+                            } else {
+                                ""
+                            }
+                        ),
+                    ));
+                }
+                out.push(Box::new(crate::effectors::MagneticDipole {
+                    name: name_of(&m.name),
+                    orbit: orbit.clone(),
+                    field,
+                    moment: v,
                 }));
             }
             EffectorSpec::Rayleigh(r) => {

@@ -1696,6 +1696,8 @@ impl ScenarioFile {
             shift: Vector3::zeros(),
             notes: std::cell::RefCell::new(Vec::new()),
             orbit: orbit.clone(),
+            epoch_unix_ns,
+            epoch_loc: loc_of(&self.epoch),
         };
         let mut built = effectors::build(&cx, &self.effectors)?;
         let mut warnings = cx.notes.into_inner();
@@ -1725,6 +1727,8 @@ impl ScenarioFile {
                         shift: -offset,
                         notes: std::cell::RefCell::new(Vec::new()),
                         orbit: orbit.clone(),
+                        epoch_unix_ns,
+                        epoch_loc: loc_of(&self.epoch),
                     };
                     built = effectors::build(&cx, &self.effectors)?;
                     warnings = cx.notes.into_inner();

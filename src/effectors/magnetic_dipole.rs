@@ -1,0 +1,165 @@
+//! `magnetic_dipole`: the torque of the Earth's magnetic field on a residual (or fixed)
+//! magnetic dipole moment carried by the hub.
+//!
+//! With m the dipole moment (A m², body axes) and B the geomagnetic field at the
+//! spacecraft's centre of mass in body axes,
+//!
+//! ```text
+//! τ = m × B,   B_body = C(q)ᵀ B_ECI
+//! ```
+//!
+//! (Wertz (ed.), *Spacecraft Attitude Determination and Control*, 1978, §17.2). B_ECI is the
+//! first-degree IGRF ([`crate::orbit::magnetic`]) at the orbit position `r(t)`, rotated from
+//! ECEF by the Earth rotation angle at the scenario epoch plus `t`. The torque is external,
+//! so the effector carries one bookkeeping state, the work done on the body
+//! `W = ∫ τ·ω dt` (J), which the energy balance subtracts. (The potential −m·B is not
+//! conserved: B turns in inertial space as the spacecraft moves and the Earth rotates.)
+
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum};
+use crate::orbit::{GeomagneticField, Orbit};
+use nalgebra::Vector3;
+use std::sync::Arc;
+
+/// A constant magnetic dipole moment on the hub in the Earth's field.
+#[derive(Debug, Clone)]
+pub struct MagneticDipole {
+    /// Name (telemetry topic).
+    pub name: String,
+    /// The orbit of the spacecraft's centre of mass.
+    pub orbit: Arc<Orbit>,
+    /// The geomagnetic field along the run (carries the scenario epoch).
+    pub field: GeomagneticField,
+    /// The dipole moment m (A m², body axes).
+    pub moment: Vector3<f64>,
+}
+
+impl MagneticDipole {
+    /// The geomagnetic field (T, body axes) at time `t` (s) for the attitude `q` (w, x, y, z;
+    /// body → inertial; normalised here).
+    #[inline]
+    pub fn field_body(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        let (r_hat, radius) = self.orbit.direction(t);
+        let b_n = self.field.field_eci(t, &r_hat, radius);
+        // C(q)ᵀ v for the integrated, not quite unit, quaternion q is |q|² times the rotated
+        // vector: v' = (w² − |u|²) v + 2 (u·v) u − 2 w (u × v). Dividing by |q|² normalises
+        // exactly, without a square root.
+        let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
+        let norm2 = w * w + u.norm_squared();
+        let rotated =
+            (w * w - u.norm_squared()) * b_n + 2.0 * u.dot(&b_n) * u - 2.0 * w * u.cross(&b_n);
+        rotated / norm2
+    }
+
+    /// The torque m × B (N m, body axes) at `t` for attitude `q`.
+    #[inline]
+    pub fn torque_at(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.moment.cross(&self.field_body(t, q))
+    }
+}
+
+impl Effector for MagneticDipole {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn kind(&self) -> &'static str {
+        "magnetic_dipole"
+    }
+    fn num_states(&self) -> usize {
+        1
+    }
+    fn num_dynamic_states(&self) -> usize {
+        0
+    }
+    fn state_names(&self) -> Vec<String> {
+        vec!["work".into()]
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        vec![0.0]
+    }
+    fn is_external(&self) -> bool {
+        true
+    }
+    fn scratch_len(&self) -> usize {
+        3
+    }
+    fn torque_only(&self) -> bool {
+        true
+    }
+    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
+        self.torque_at(hub.t, hub.attitude)
+    }
+    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
+        let tau = self.torque_at(hub.t, hub.attitude);
+        coupling.add_torque(&tau);
+        scratch[..3].copy_from_slice(tau.as_slice());
+    }
+    fn derivatives(
+        &self,
+        hub: &HubState,
+        _accel: &HubAcceleration,
+        _x: &[f64],
+        scratch: &[f64],
+        dx: &mut [f64],
+    ) {
+        // Power of the torque on the hub: τ·ω.
+        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
+    }
+    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
+        Momentum::default()
+    }
+    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
+        EnergyAccount {
+            work: x[0],
+            ..EnergyAccount::default()
+        }
+    }
+    fn telemetry_names(&self) -> Vec<String> {
+        [
+            "torque_x", "torque_y", "torque_z", "b_x", "b_y", "b_z", "work",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    }
+    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
+        let b = self.field_body(hub.t, hub.attitude);
+        let tau = self.moment.cross(&b);
+        vec![tau[0], tau[1], tau[2], b[0], b[1], b[2], x[0]]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::orbit::{CentralBody, Elements};
+    use nalgebra::UnitQuaternion;
+
+    /// The square-root-free rotation against nalgebra's, for a quaternion off unit norm by
+    /// 1e-3.
+    #[test]
+    fn the_fast_body_field_equals_the_rotated_field() {
+        let orbit = Orbit::new(
+            CentralBody::EARTH,
+            Elements::new(6.9e6, 0.01, 0.9, 0.4, 1.1, 0.2),
+            false,
+        )
+        .unwrap();
+        let md = MagneticDipole {
+            name: "m".into(),
+            orbit: Arc::new(orbit),
+            field: GeomagneticField::new(1_700_000_000_000_000_000),
+            moment: Vector3::new(0.1, -0.2, 0.3),
+        };
+        let q = UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
+        let raw = [q.w * 1.001, q.i * 1.001, q.j * 1.001, q.k * 1.001];
+        for t in [0.0, 1234.5, 9876.0] {
+            let (r_hat, radius) = md.orbit.direction(t);
+            let expected = q.inverse_transform_vector(&md.field.field_eci(t, &r_hat, radius));
+            let got = md.field_body(t, &raw);
+            assert!(
+                (got - expected).norm() <= 1e-14 * expected.norm(),
+                "t = {t}: {got:?} vs {expected:?}"
+            );
+        }
+    }
+}
