@@ -209,8 +209,8 @@ fn bench_environment_rhs(repeats: usize) {
     let calls = 20_000;
     let rigid = load(yaml("", ""));
     println!(
-        "\ntorque effectors (the machinery alone, then the gravity gradient), one \
-         right-hand-side evaluation against the rigid body:"
+        "\ntorque effectors (the machinery alone, then the gravity gradient and the magnetic \
+         dipole), one right-hand-side evaluation against the rigid body:"
     );
     let gravity = "effectors:\n  - gravity_gradient: {}\n";
     for (label, orbit, effectors) in [
@@ -228,6 +228,11 @@ fn bench_environment_rhs(repeats: usize) {
             "e = 0.7 orbit",
             "orbit: {semi_major_axis_km: 25000, eccentricity: 0.7}\n",
             gravity,
+        ),
+        (
+            "magnetic dipole",
+            "orbit: {semi_major_axis_km: 6878.137, inclination_deg: 51.6}\n",
+            "effectors:\n  - magnetic_dipole: {moment: [0.05, 0, 0]}\n",
         ),
     ] {
         let with = load(yaml(orbit, effectors));
