@@ -1060,7 +1060,7 @@ fn fuzz_outputs(case: OutputsCase) {
         let summary: serde_json::Value = serde_json::from_str(&read("summary.json"))
             .unwrap_or_else(|e| panic!("summary.json does not parse: {e}"));
         let status = &summary["status"];
-        let counted: u64 = ["complete", "stopped", "failed", "invalid"]
+        let counted: u64 = ["complete", "stopped", "failed", "invalid", "invalid_model"]
             .iter()
             .map(|k| status[k].as_u64().expect("a status count"))
             .sum();
