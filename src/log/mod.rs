@@ -6,9 +6,13 @@
 //! `/effectors/<name>` channels share one schema per effector kind and field set
 //! (`polhode.effectors.HingedRodFlapLag`, [`units::effector_message`]); every field of the
 //! polhode schemas carries its unit as its protobuf comment ([`units::field_unit`]).
+//! A scenario with an orbit adds `/orbit` (`polhode.Orbit`: position, velocity, altitude and
+//! the attitude relative to LVLH) and an `lvlh` frame in `/tf`; a scenario without one writes
+//! neither.
 //! Log time = scenario epoch + sim time. The file is written under a temporary name in the
 //! target directory and renamed when finished, so a final name never holds a half-written log.
 
+pub mod orbit;
 pub mod telemetry;
 pub mod units;
 
@@ -24,11 +28,14 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{self, BufWriter, Write as _};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Frame names used in `/tf` and `/scene`.
 pub const WORLD_FRAME: &str = "world";
 /// The body frame.
 pub const BODY_FRAME: &str = "body";
+/// The LVLH (orbit) frame, in `/tf` only for scenarios with an orbit.
+pub const LVLH_FRAME: &str = "lvlh";
 
 /// A file attached to an MCAP log.
 #[derive(Debug, Clone)]
@@ -55,6 +62,10 @@ pub struct McapLogger<'a> {
     scene: SceneStyle,
     /// Name of the body frame (`body`, or `<prefix>/body` when runs share a file).
     body_frame: String,
+    /// The scenario's orbit, if any: `/orbit` and the LVLH frame in `/tf`.
+    orbit: Option<Arc<crate::orbit::Orbit>>,
+    /// Name of the LVLH frame (`lvlh`, or `<prefix>/lvlh`).
+    lvlh_frame: String,
     /// The polhode schemas and channels registered so far.
     registry: Registry,
     buf: Vec<u8>,
@@ -75,6 +86,8 @@ struct Channels {
     scene: u16,
     telemetry: u16,
     log: u16,
+    /// `/orbit`, for a scenario with an orbit.
+    orbit: Option<u16>,
 }
 
 /// A temporary file that is removed when dropped (on errors and panics alike) unless it was
@@ -136,11 +149,16 @@ impl SceneStyle {
 
 /// The body frame's name for topics under `prefix`.
 fn body_frame(prefix: &str) -> String {
+    frame_name(prefix, BODY_FRAME)
+}
+
+/// The name of `frame` for topics under `prefix`: `frame`, or `<prefix>/<frame>`.
+fn frame_name(prefix: &str, frame: &str) -> String {
     let p = prefix.trim_matches('/');
     if p.is_empty() {
-        BODY_FRAME.to_string()
+        frame.to_string()
     } else {
-        format!("{p}/{BODY_FRAME}")
+        format!("{p}/{frame}")
     }
 }
 
@@ -198,12 +216,34 @@ fn register(
             ]),
         )?);
     }
+    // Only for a scenario with an orbit: a scenario without one writes the same file as before.
+    let orbit = match &scenario.orbit {
+        Some(_) => {
+            let schema = orbit::schema_bytes();
+            registry.bytes += orbit::SCHEMA_NAME.len() + schema.len();
+            let id = writer
+                .add_schema(orbit::SCHEMA_NAME, "protobuf", &schema)
+                .map_err(io_err)?;
+            Some(add_channel(
+                writer,
+                registry,
+                id,
+                format!("{prefix}/orbit"),
+                BTreeMap::from([(
+                    "units".to_string(),
+                    telemetry::units_metadata(units::ORBIT, &orbit::FIELDS),
+                )]),
+            )?)
+        }
+        None => None,
+    };
     Ok((
         Channels {
             tf,
             scene,
             telemetry,
             log,
+            orbit,
         },
         effector_channels,
     ))
@@ -325,6 +365,8 @@ impl<'a> McapLogger<'a> {
             sequence: 0,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
             body_frame: body_frame(prefix),
+            orbit: scenario.orbit.clone(),
+            lvlh_frame: frame_name(prefix, LVLH_FRAME),
             registry,
             buf: Vec::with_capacity(1024),
         })
@@ -359,6 +401,8 @@ impl<'a> McapLogger<'a> {
             sequence,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
             body_frame: body_frame(prefix),
+            orbit: scenario.orbit.clone(),
+            lvlh_frame: frame_name(prefix, LVLH_FRAME),
             registry,
             buf,
         })
@@ -554,6 +598,11 @@ impl<'a> McapLogger<'a> {
         let mut per_sample = self.encoded_len(&tf) + PER_MESSAGE;
         telemetry::encode_doubles(&telemetry::values(&o, &inv), &mut self.buf);
         per_sample += self.buf.len() as f64 + PER_MESSAGE;
+        if let Some(orbit) = &self.orbit {
+            // Every field is written (zeros too), so any instant encodes to the same length.
+            telemetry::encode_doubles(&orbit::values(orbit, 0.0, &o.attitude), &mut self.buf);
+            per_sample += self.buf.len() as f64 + PER_MESSAGE;
+        }
         let hub = HubState {
             t: 0.0,
             omega: o.omega,
@@ -577,27 +626,31 @@ impl<'a> McapLogger<'a> {
         1.1 * (samples * per_sample + scenes * per_scene) + fixed
     }
 
-    /// The `/tf` message placing the body frame in `world` at the observation's attitude.
+    /// The `/tf` message placing the body frame in `world` at the observation's attitude,
+    /// followed, for a scenario with an orbit, by the LVLH frame in `world` (at the origin,
+    /// like the body, rotated by `q_NO`).
     fn body_transform(&self, o: &Observation) -> fg::FrameTransforms {
-        let q = o.attitude;
-        fg::FrameTransforms {
-            transforms: vec![fg::FrameTransform {
-                timestamp: Some(self.timestamp(o.t)),
-                parent_frame_id: WORLD_FRAME.into(),
-                child_frame_id: self.body_frame.clone(),
-                translation: Some(fg::Vector3 {
-                    x: 0.0,
-                    y: 0.0,
-                    z: 0.0,
-                }),
-                rotation: Some(fg::Quaternion {
-                    x: q.i,
-                    y: q.j,
-                    z: q.k,
-                    w: q.w,
-                }),
-            }],
+        let transform = |child: &str, q: &UnitQuaternion<f64>| fg::FrameTransform {
+            timestamp: Some(self.timestamp(o.t)),
+            parent_frame_id: WORLD_FRAME.into(),
+            child_frame_id: child.to_string(),
+            translation: Some(fg::Vector3 {
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+            }),
+            rotation: Some(fg::Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            }),
+        };
+        let mut transforms = vec![transform(&self.body_frame, &o.attitude)];
+        if let Some(orbit) = &self.orbit {
+            transforms.push(transform(&self.lvlh_frame, &orbit.lvlh(o.t).lvlh_to_eci()));
         }
+        fg::FrameTransforms { transforms }
     }
 
     fn encoded_len<T: Encode>(&mut self, msg: &T) -> f64 {
@@ -809,6 +862,11 @@ impl Sink for McapLogger<'_> {
         let values = telemetry::values(o, inv);
         telemetry::encode_doubles(&values, &mut self.buf);
         self.write_raw(self.channels.telemetry, self.log_time(o.t))?;
+        if let (Some(channel), Some(orbit)) = (self.channels.orbit, &self.orbit) {
+            let values = orbit::values(orbit, o.t, &o.attitude);
+            telemetry::encode_doubles(&values, &mut self.buf);
+            self.write_raw(channel, self.log_time(o.t))?;
+        }
         if !self.effector_channels.is_empty() {
             let hub = HubState {
                 t: o.t,
@@ -1172,6 +1230,21 @@ mod tests {
             5.0,
             Some(Compression::None),
             &dir.join("e.mcap"),
+        );
+        let ratio = bytes.len() as f64 / estimate;
+        assert!((0.6..=1.0).contains(&ratio), "actual / estimate = {ratio}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The estimate counts `/orbit` and the `lvlh` transform for a scenario with an orbit.
+    #[test]
+    fn estimate_covers_a_log_with_an_orbit() {
+        let dir = scratch("estimate-orbit");
+        let (bytes, estimate) = run(
+            &shipped("gravity-gradient-smallsat.yaml"),
+            2000.0,
+            Some(Compression::None),
+            &dir.join("o.mcap"),
         );
         let ratio = bytes.len() as f64 / estimate;
         assert!((0.6..=1.0).contains(&ratio), "actual / estimate = {ratio}");

@@ -11,6 +11,9 @@ use std::borrow::Cow;
 /// The `kind` under which [`field_unit`] knows the fields of `/telemetry`.
 pub const TELEMETRY: &str = "telemetry";
 
+/// The `kind` under which [`field_unit`] knows the fields of `/orbit`.
+pub const ORBIT: &str = "orbit";
+
 /// The unit of a dimensionless quantity (a ratio, a quaternion component).
 pub const DIMENSIONLESS: &str = "1";
 
@@ -132,12 +135,75 @@ const TELEMETRY_FIELDS: [(&str, &str, &str); 26] = [
     ),
 ];
 
-/// Description and unit of `field` of `/telemetry` (`kind` = [`TELEMETRY`]) or of the
+/// `/orbit`: field, description, unit.
+const ORBIT_FIELDS: [(&str, &str, &str); 16] = [
+    ("sim_time", "Simulation time since the epoch", "s"),
+    ("r_eci_x", "Spacecraft position, ECI x", "km"),
+    ("r_eci_y", "Spacecraft position, ECI y", "km"),
+    ("r_eci_z", "Spacecraft position, ECI z", "km"),
+    ("v_eci_x", "Spacecraft velocity, ECI x", "km/s"),
+    ("v_eci_y", "Spacecraft velocity, ECI y", "km/s"),
+    ("v_eci_z", "Spacecraft velocity, ECI z", "km/s"),
+    (
+        "altitude",
+        "Altitude above the sphere of the central body's equatorial radius, |r| - R",
+        "km",
+    ),
+    (
+        "argument_of_latitude_deg",
+        "Argument of latitude u, from the ascending node to the spacecraft, in [0, 360)",
+        "deg",
+    ),
+    (
+        "q_lvlh_w",
+        "Attitude quaternion body to LVLH, q_OB = q_NO^-1 q_NB, Hamilton, sign with w >= 0, scalar part",
+        DIMENSIONLESS,
+    ),
+    (
+        "q_lvlh_x",
+        "Attitude quaternion body to LVLH, x part",
+        DIMENSIONLESS,
+    ),
+    (
+        "q_lvlh_y",
+        "Attitude quaternion body to LVLH, y part",
+        DIMENSIONLESS,
+    ),
+    (
+        "q_lvlh_z",
+        "Attitude quaternion body to LVLH, z part",
+        DIMENSIONLESS,
+    ),
+    (
+        "roll_deg",
+        "Roll, 3-2-1 Euler angle about the body 1 axis, the last rotation, in (-180, 180]",
+        "deg",
+    ),
+    (
+        "pitch_deg",
+        "Pitch, 3-2-1 Euler angle about the intermediate 2 axis, in [-90, 90]",
+        "deg",
+    ),
+    (
+        "yaw_deg",
+        "Yaw, 3-2-1 Euler angle about the LVLH o3 nadir axis, the first rotation, in (-180, 180]",
+        "deg",
+    ),
+];
+
+/// Description and unit of `field` of `/telemetry` (`kind` = [`TELEMETRY`]), of `/orbit`
+/// (`kind` = [`ORBIT`]) or of the
 /// telemetry of an effector of `kind` (its YAML kind, e.g. `hinged_rod`; `sim_time`
 /// included). `None` when the field is not known for that kind.
 pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'static str)> {
     if kind == TELEMETRY {
         return TELEMETRY_FIELDS
+            .iter()
+            .find(|(name, ..)| *name == field)
+            .map(|&(_, d, u)| (Cow::Borrowed(d), u));
+    }
+    if kind == ORBIT {
+        return ORBIT_FIELDS
             .iter()
             .find(|(name, ..)| *name == field)
             .map(|&(_, d, u)| (Cow::Borrowed(d), u));
@@ -313,6 +379,14 @@ mod tests {
             assert!(!d.is_empty() && !u.is_empty(), "{f}");
         }
         assert_eq!(field_unit(TELEMETRY, "omega").map(|x| x.1), None);
+    }
+
+    #[test]
+    fn orbit_table_follows_fields() {
+        let names: Vec<&str> = ORBIT_FIELDS.iter().map(|(n, ..)| *n).collect();
+        assert_eq!(names, crate::log::orbit::FIELDS);
+        assert_eq!(field_unit(ORBIT, "altitude").unwrap().1, "km");
+        assert_eq!(field_unit(ORBIT, "omega_x"), None);
     }
 
     #[test]

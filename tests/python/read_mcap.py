@@ -48,7 +48,15 @@ What it checks:
     - an attachment "scenario.yaml" with non-empty UTF-8 data.
   /tf (foxglove.FrameTransforms)
     - exactly one transform, parent_frame_id "world", child_frame_id "body",
-      | |q| - 1 | <= 1e-9, and timestamp (seconds, nanos) == the log time.
+      | |q| - 1 | <= 1e-9, and timestamp (seconds, nanos) == the log time;
+      in a log with an /orbit channel, a second transform "world" -> "lvlh",
+      likewise a unit quaternion stamped at the log time.
+  /orbit (polhode.Orbit), only in the log of a scenario with an orbit
+    - the fields listed in ORBIT_FIELDS exist, all finite, one message per
+      /telemetry sample at the same log times;
+    - q_NB (the /tf body rotation) == q_NO (the /tf lvlh rotation) x q_OB
+      (q_lvlh_w, q_lvlh_x, q_lvlh_y, q_lvlh_z) up to sign within 1e-9, with
+      q_lvlh_w >= 0.
   /telemetry (polhode.Telemetry)
     - the scalar numeric fields listed in TELEMETRY_FIELDS exist, all finite;
     - (log_time - first /telemetry log_time) == sim_time within 1 us;
@@ -106,6 +114,15 @@ REQUIRED_CHANNELS = {
     "/telemetry": "polhode.Telemetry",
     "/log": "foxglove.Log",
 }
+ORBIT_FIELDS = (
+    "sim_time",
+    "r_eci_x", "r_eci_y", "r_eci_z",
+    "v_eci_x", "v_eci_y", "v_eci_z",
+    "altitude", "argument_of_latitude_deg",
+    "q_lvlh_w", "q_lvlh_x", "q_lvlh_y", "q_lvlh_z",
+    "roll_deg", "pitch_deg", "yaw_deg",
+)
+ORBIT_Q_TOL = 1e-9
 METADATA_NAME = "polhode"
 METADATA_KEYS = ("version", "scenario", "integrator", "epoch", "quaternion_convention", "status")
 ATTACHMENT_NAME = "scenario.yaml"
@@ -278,6 +295,10 @@ class McapCheck:
         self.scene_messages = 0
         self.scene_body_entity = False
         self.scene_seen_partial: list[str] = []
+        self.has_orbit = False
+        # log_time -> (w, x, y, z) of the /tf lvlh rotation, and the /orbit samples
+        self.lvlh_by_time: dict[int, tuple[float, float, float, float]] = {}
+        self.orbit: list[tuple[int, dict[str, float]]] = []
 
     # ------------------------------------------------------------------ driver
     def run(self) -> None:
@@ -297,6 +318,9 @@ class McapCheck:
                     ) from exc
                 summary = self._read_summary(reader)
                 self._check_channels(summary)
+                self.has_orbit = any(
+                    ch.topic == "/orbit" for ch in getattr(summary, "channels", {}).values()
+                )
                 self._linear_pass()
                 self._indexed_pass(reader, summary)
                 self._read_metadata(reader)
@@ -307,6 +331,7 @@ class McapCheck:
         self._check_metadata()
         self._check_counts()
         self._check_tf_telemetry()
+        self._check_orbit()
         self._check_scene()
         if self.spin_z is not None:
             self._check_spin_z(self.spin_z)
@@ -571,6 +596,8 @@ class McapCheck:
             self._on_scene(log_time, msg)
         elif topic == "/log":
             self._on_log(log_time, msg)
+        elif topic == "/orbit":
+            self._on_orbit(log_time, msg)
         elif topic.startswith("/effectors/"):
             self._on_effector(topic, log_time, msg)
 
@@ -589,10 +616,27 @@ class McapCheck:
         where = f"/tf {_fmt_t(log_time)}"
         self.tf_times.append(log_time)
         transforms = list(msg.transforms)
-        if len(transforms) != 1:
-            self.checks.fail("tf", f"{where}: {len(transforms)} transforms, expected 1")
+        expected = 2 if self.has_orbit else 1
+        if len(transforms) != expected:
+            self.checks.fail("tf", f"{where}: {len(transforms)} transforms, expected {expected}")
             if not transforms:
                 return
+        if self.has_orbit and len(transforms) >= 2:
+            lvlh = transforms[1]
+            if lvlh.parent_frame_id != "world" or lvlh.child_frame_id != "lvlh":
+                self.checks.fail(
+                    "tf frames",
+                    f"{where}: {lvlh.parent_frame_id!r} -> {lvlh.child_frame_id!r}, "
+                    "expected 'world' -> 'lvlh'",
+                )
+            if _ts_ns(lvlh.timestamp) != log_time:
+                self.checks.fail("tf timestamp", f"{where}: lvlh timestamp != log time")
+            r = lvlh.rotation
+            q = (r.w, r.x, r.y, r.z)
+            norm = math.sqrt(sum(c * c for c in q))
+            if not math.isfinite(norm) or abs(norm - 1.0) > UNIT_QUAT_TOL:
+                self.checks.fail("tf unit", f"{where}: lvlh |q| = {norm!r}")
+            self.lvlh_by_time[log_time] = q
         tf = transforms[0]
         if tf.parent_frame_id != "world" or tf.child_frame_id != "body":
             self.checks.fail(
@@ -642,6 +686,18 @@ class McapCheck:
             self.checks.fail("telemetry finite", f"/telemetry {_fmt_t(log_time)}: non-finite {bad}")
         self.telemetry.append((log_time, values))
 
+    def _on_orbit(self, log_time: int, msg: Any) -> None:
+        fields = msg.DESCRIPTOR.fields_by_name
+        missing = [n for n in ORBIT_FIELDS if n not in fields]
+        if missing:
+            self.checks.fail("orbit fields", f"polhode.Orbit: missing {missing}")
+            return
+        values = {name: float(getattr(msg, name)) for name in ORBIT_FIELDS}
+        bad = [name for name, v in values.items() if not math.isfinite(v)]
+        if bad:
+            self.checks.fail("orbit finite", f"/orbit {_fmt_t(log_time)}: non-finite {bad}")
+        self.orbit.append((log_time, values))
+
     def _on_scene(self, log_time: int, msg: Any) -> None:
         self.scene_messages += 1
         if self.scene_body_entity:
@@ -674,6 +730,42 @@ class McapCheck:
             if n != self.expect_samples:
                 self.checks.fail(
                     "samples", f"{topic}: {n} messages, expected {self.expect_samples}"
+                )
+
+    def _check_orbit(self) -> None:
+        if not self.has_orbit:
+            return
+        orbit_times = [t for t, _ in self.orbit]
+        telemetry_times = [t for t, _ in self.telemetry]
+        if orbit_times != telemetry_times:
+            self.checks.fail(
+                "orbit samples",
+                f"/orbit at {len(orbit_times)} log times, /telemetry at {len(telemetry_times)}; "
+                "not the same",
+            )
+        for log_time, v in self.orbit:
+            where = f"/orbit {_fmt_t(log_time)}"
+            q_ob = (v["q_lvlh_w"], v["q_lvlh_x"], v["q_lvlh_y"], v["q_lvlh_z"])
+            if q_ob[0] < 0.0:
+                self.checks.fail("orbit quaternion", f"{where}: q_lvlh_w < 0")
+            q_no = self.lvlh_by_time.get(log_time)
+            tfs = self.tf_by_time.get(log_time)
+            if q_no is None or not tfs:
+                self.checks.fail("orbit tf", f"{where}: no /tf body and lvlh at the same log time")
+                continue
+            w1, x1, y1, z1 = q_no
+            w2, x2, y2, z2 = q_ob
+            q_nb = (
+                w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+            )
+            dot = abs(sum(a * b for a, b in zip(q_nb, tfs[0])))
+            if 1.0 - dot > ORBIT_Q_TOL:
+                self.checks.fail(
+                    "orbit quaternion",
+                    f"{where}: q_NO x q_OB differs from the /tf body rotation (1 - |dot| = {1.0 - dot:.1e})",
                 )
 
     def _check_tf_telemetry(self) -> None:

@@ -148,6 +148,12 @@ def check_raw(mcap: Path, ref: dict) -> None:
     for frame, (t_ref, q_ref) in ref["tf"].items():
         topic = next((p for p in ents if p.endswith("/tf") and frame.startswith(p[1:-3])), "/tf")
         t, arr = column(ents.get(topic, []), "Transform3D:quaternion")
+        # A /tf message with several transforms (body and lvlh, for a scenario with an orbit)
+        # gives one row per transform: keep this frame's rows.
+        _, child = column(ents.get(topic, []), "Transform3D:child_frame")
+        if arr is not None and child is not None and len(child) == len(arr):
+            keep = np.array([bool(c) and c[0] == frame for c in child.to_pylist()], bool)
+            t, arr = t[keep], arr.filter(pa.array(keep))
         n = 0 if arr is None else len(arr)
         if report(n == len(t_ref), f"{topic}: {n} Transform3D rows for {len(t_ref)} samples of frame {frame}"):
             report(np.array_equal(t, t_ref), f"{topic}: same log times")
