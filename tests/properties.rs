@@ -1658,6 +1658,12 @@ const ALL_KEYS: &[&str] = &[
     "j2_secular",
     "magnetic_dipole",
     "moment",
+    "solar_pressure",
+    "area",
+    "normal",
+    "center_of_pressure",
+    "specular",
+    "diffuse",
 ];
 
 impl Valid {

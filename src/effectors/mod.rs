@@ -8,6 +8,7 @@
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
+//! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
 //!
 //! The three mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
@@ -21,6 +22,7 @@ pub mod modal;
 pub mod motion;
 pub mod particles;
 pub mod rayleigh;
+pub mod solar_pressure;
 pub mod spring_mass;
 pub mod wheel;
 
@@ -32,6 +34,7 @@ pub use modal::ModalBeam;
 pub use motion::SpinUp;
 pub use particles::{ParticleEffector, ParticleModel};
 pub use rayleigh::Rayleigh;
+pub use solar_pressure::SolarPressure;
 pub use spring_mass::SpringMass;
 pub use wheel::WheelDamper;
 

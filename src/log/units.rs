@@ -281,6 +281,24 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("magnetic_dipole", "work") => {
             return fixed("Work done by the magnetic torque since the start", "J");
         }
+        ("solar_pressure", "torque_x") => {
+            return fixed("Solar pressure torque r_cp × F on the hub, body x", "N m");
+        }
+        ("solar_pressure", "torque_y") => {
+            return fixed("Solar pressure torque r_cp × F on the hub, body y", "N m");
+        }
+        ("solar_pressure", "torque_z") => {
+            return fixed("Solar pressure torque r_cp × F on the hub, body z", "N m");
+        }
+        ("solar_pressure", "sun_x") => return fixed("Unit vector to the Sun, body x", "1"),
+        ("solar_pressure", "sun_y") => return fixed("Unit vector to the Sun, body y", "1"),
+        ("solar_pressure", "sun_z") => return fixed("Unit vector to the Sun, body z", "1"),
+        ("solar_pressure", "illuminated") => {
+            return fixed("1 in sunlight, 0 in the Earth's cylindrical shadow", "1");
+        }
+        ("solar_pressure", "work") => {
+            return fixed("Work done by the solar pressure since the start", "J");
+        }
         _ => {}
     }
     if kind == "modal_appendage" {

@@ -35,7 +35,36 @@ pub enum EffectorSpec {
     GravityGradient(GravityGradientSpec),
     /// A constant magnetic dipole moment in the Earth's field (needs `orbit:`).
     MagneticDipole(MagneticDipoleSpec),
+    /// Solar radiation pressure on a flat plate (needs `orbit:`).
+    SolarPressure(SolarPressureSpec),
 }
+
+/// `solar_pressure:` — one flat plate in the Sun's radiation, one-sided, in the Earth's
+/// cylindrical shadow.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolarPressureSpec {
+    /// Name (default `solar_pressure`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Plate area (m²).
+    pub area: Spanned<f64>,
+    /// Normal of the plate's sunlit face (body axes; normalised).
+    pub normal: Spanned<[f64; 3]>,
+    /// Centre of pressure relative to the hub's centre of mass (m, body axes).
+    pub center_of_pressure: Spanned<[f64; 3]>,
+    /// Specular reflectivity ρs (0 to 1).
+    pub specular: Spanned<f64>,
+    /// Diffuse reflectivity ρd (0 to 1, ρs + ρd ≤ 1).
+    pub diffuse: Spanned<f64>,
+}
+
+/// Largest distance of a `solar_pressure` centre of pressure from the hub's centre of mass
+/// (m).
+pub const MAX_PRESSURE_ARM: f64 = 1e3;
+/// Unix time (s) of 2050-01-01T00:00Z, the end of the span of the low-precision solar
+/// coordinates (1950–2050).
+pub const SOLAR_EPHEMERIS_END_UNIX_S: f64 = 2_524_608_000.0;
 
 /// `magnetic_dipole:` — a constant (residual) dipole moment on the hub in the first-degree
 /// IGRF field of the Earth.
@@ -497,6 +526,7 @@ pub(super) fn build(
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
+            EffectorSpec::SolarPressure(_) => "solar_pressure",
         };
         let ck = Check {
             path: cx.path,
@@ -579,6 +609,94 @@ pub(super) fn build(
                     orbit: orbit.clone(),
                     field,
                     moment: v,
+                }));
+            }
+            EffectorSpec::SolarPressure(sp) => {
+                let Some(orbit) = &cx.orbit else {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        item,
+                        ck.prefix.clone(),
+                        "an environmental torque needs the spacecraft's orbit: add an \
+                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
+                         inclination_deg, …)",
+                    ));
+                };
+                let area = ck.positive(&sp.area, "area", "m²")?;
+                let n = Vector3::from(sp.normal.value);
+                if !n.iter().all(|c| c.is_finite()) || n.norm() < MIN_POSITIVE {
+                    return Err(ck.err(
+                        &sp.normal,
+                        "normal",
+                        format!(
+                            "expected a non-zero vector of three finite numbers (body axes), \
+                             got [{}, {}, {}]",
+                            sp.normal.value[0], sp.normal.value[1], sp.normal.value[2]
+                        ),
+                    ));
+                }
+                let r_cp = Vector3::from(sp.center_of_pressure.value);
+                if !r_cp.iter().all(|c| c.is_finite()) || r_cp.norm() > MAX_PRESSURE_ARM {
+                    return Err(ck.err(
+                        &sp.center_of_pressure,
+                        "center_of_pressure",
+                        format!(
+                            "expected three finite numbers within {MAX_PRESSURE_ARM:e} m of \
+                             the centre of mass (m, body axes), got [{}, {}, {}]",
+                            sp.center_of_pressure.value[0],
+                            sp.center_of_pressure.value[1],
+                            sp.center_of_pressure.value[2]
+                        ),
+                    ));
+                }
+                let mut rho = [0.0; 2];
+                for (k, (v, key)) in [(&sp.specular, "specular"), (&sp.diffuse, "diffuse")]
+                    .into_iter()
+                    .enumerate()
+                {
+                    if !(0.0..=1.0).contains(&v.value) {
+                        return Err(ck.err(
+                            v,
+                            key,
+                            format!(
+                                "expected a reflectivity from 0 to 1, got {}",
+                                super::number(v.value)
+                            ),
+                        ));
+                    }
+                    rho[k] = v.value;
+                }
+                if rho[0] + rho[1] > 1.0 {
+                    return Err(ck.err(
+                        &sp.diffuse,
+                        "diffuse",
+                        format!(
+                            "expected specular + diffuse at most 1 (the rest is absorbed), got \
+                             {} + {} = {}",
+                            rho[0],
+                            rho[1],
+                            rho[0] + rho[1]
+                        ),
+                    ));
+                }
+                if cx.epoch_unix_ns as f64 * 1e-9 >= SOLAR_EPHEMERIS_END_UNIX_S {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        cx.epoch_loc.or(item),
+                        "epoch",
+                        "the low-precision solar coordinates (Vallado Algorithm 29) hold from \
+                         1950 to 2050: choose an epoch before 2050-01-01",
+                    ));
+                }
+                out.push(Box::new(crate::effectors::SolarPressure {
+                    name: name_of(&sp.name),
+                    orbit: orbit.clone(),
+                    epoch_unix_ns: cx.epoch_unix_ns,
+                    area,
+                    normal: n.normalize(),
+                    center_of_pressure: r_cp + cx.shift,
+                    specular: rho[0],
+                    diffuse: rho[1],
                 }));
             }
             EffectorSpec::Rayleigh(r) => {
