@@ -1664,6 +1664,8 @@ const ALL_KEYS: &[&str] = &[
     "center_of_pressure",
     "specular",
     "diffuse",
+    "aerodynamic",
+    "drag_coefficient",
 ];
 
 impl Valid {

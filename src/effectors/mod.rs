@@ -9,10 +9,12 @@
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
+//! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure.
 //!
 //! The three mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
 
+pub mod aerodynamic;
 pub mod beam;
 pub mod energy_sink;
 pub mod gravity_gradient;
@@ -26,6 +28,7 @@ pub mod solar_pressure;
 pub mod spring_mass;
 pub mod wheel;
 
+pub use aerodynamic::Aerodynamic;
 pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};

@@ -299,6 +299,30 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("solar_pressure", "work") => {
             return fixed("Work done by the solar pressure since the start", "J");
         }
+        ("aerodynamic", "torque_x") => {
+            return fixed("Aerodynamic torque r_cp × F on the hub, body x", "N m");
+        }
+        ("aerodynamic", "torque_y") => {
+            return fixed("Aerodynamic torque r_cp × F on the hub, body y", "N m");
+        }
+        ("aerodynamic", "torque_z") => {
+            return fixed("Aerodynamic torque r_cp × F on the hub, body z", "N m");
+        }
+        ("aerodynamic", "density") => {
+            return fixed("Atmospheric density (exponential model)", "kg/m^3");
+        }
+        ("aerodynamic", "wind_x") => {
+            return fixed("Velocity through the co-rotating air, body x", "m/s");
+        }
+        ("aerodynamic", "wind_y") => {
+            return fixed("Velocity through the co-rotating air, body y", "m/s");
+        }
+        ("aerodynamic", "wind_z") => {
+            return fixed("Velocity through the co-rotating air, body z", "m/s");
+        }
+        ("aerodynamic", "work") => {
+            return fixed("Work done by the aerodynamic torque since the start", "J");
+        }
         _ => {}
     }
     if kind == "modal_appendage" {

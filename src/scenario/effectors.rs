@@ -37,7 +37,31 @@ pub enum EffectorSpec {
     MagneticDipole(MagneticDipoleSpec),
     /// Solar radiation pressure on a flat plate (needs `orbit:`).
     SolarPressure(SolarPressureSpec),
+    /// Drag on a constant projected area with a fixed centre of pressure (needs `orbit:`).
+    Aerodynamic(AerodynamicSpec),
 }
+
+/// `aerodynamic:` — drag on a constant projected area, acting at a fixed centre of pressure,
+/// in the exponential atmosphere of Vallado's Table 8-4.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AerodynamicSpec {
+    /// Name (default `aerodynamic`).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Drag coefficient C_d (dimensionless; 2.2 is customary in LEO).
+    pub drag_coefficient: Spanned<f64>,
+    /// Projected area A (m²), the same for every attitude.
+    pub area: Spanned<f64>,
+    /// Centre of pressure (m, body axes, about the hub's centre of mass).
+    pub center_of_pressure: Spanned<[f64; 3]>,
+}
+
+/// Largest `aerodynamic` drag coefficient: free-molecular flat plates and spheres are 2 to 3.
+pub const MAX_DRAG_COEFFICIENT: f64 = 10.0;
+
+/// Largest distance (m) of an `aerodynamic` centre of pressure from the centre of mass.
+pub const MAX_CENTER_OF_PRESSURE: f64 = 1e3;
 
 /// `solar_pressure:` — one flat plate in the Sun's radiation, one-sided, in the Earth's
 /// cylindrical shadow.
@@ -527,6 +551,7 @@ pub(super) fn build(
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
             EffectorSpec::SolarPressure(_) => "solar_pressure",
+            EffectorSpec::Aerodynamic(_) => "aerodynamic",
         };
         let ck = Check {
             path: cx.path,
@@ -697,6 +722,52 @@ pub(super) fn build(
                     center_of_pressure: r_cp + cx.shift,
                     specular: rho[0],
                     diffuse: rho[1],
+                }));
+            }
+            EffectorSpec::Aerodynamic(a) => {
+                let Some(orbit) = &cx.orbit else {
+                    return Err(ScenarioError::at(
+                        cx.path,
+                        item,
+                        ck.prefix.clone(),
+                        "an environmental torque needs the spacecraft's orbit: add an \
+                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
+                         inclination_deg, …)",
+                    ));
+                };
+                let cd = a.drag_coefficient.value;
+                if !(cd > 0.0 && cd <= MAX_DRAG_COEFFICIENT) {
+                    return Err(ck.err(
+                        &a.drag_coefficient,
+                        "drag_coefficient",
+                        format!(
+                            "expected a value in (0, {MAX_DRAG_COEFFICIENT}] (dimensionless; \
+                             2.2 is customary in LEO), got {}",
+                            super::number(cd)
+                        ),
+                    ));
+                }
+                let area = ck.positive(&a.area, "area", "m²")?;
+                let cp = Vector3::from(a.center_of_pressure.value);
+                if !cp.iter().all(|c| c.is_finite()) || cp.norm() > MAX_CENTER_OF_PRESSURE {
+                    return Err(ck.err(
+                        &a.center_of_pressure,
+                        "center_of_pressure",
+                        format!(
+                            "expected three finite numbers within {MAX_CENTER_OF_PRESSURE:e} m \
+                             of the centre of mass (m, body axes), got [{}, {}, {}]",
+                            a.center_of_pressure.value[0],
+                            a.center_of_pressure.value[1],
+                            a.center_of_pressure.value[2]
+                        ),
+                    ));
+                }
+                out.push(Box::new(crate::effectors::Aerodynamic {
+                    name: name_of(&a.name),
+                    orbit: orbit.clone(),
+                    drag_coefficient: cd,
+                    area,
+                    center_of_pressure: cp,
                 }));
             }
             EffectorSpec::Rayleigh(r) => {
