@@ -17,7 +17,7 @@
 //! the wind in body axes. The torque is external, so the effector carries one bookkeeping
 //! state, the work done on the body `W = ∫ τ·ω dt` (J), which the energy balance subtracts.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum};
+use super::environment::{EnvironmentTorque, names, to_body};
 use crate::orbit::Orbit;
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -112,11 +112,7 @@ impl Aerodynamic {
     #[inline]
     pub fn density_and_wind(&self, t: f64, q: &[f64]) -> (f64, Vector3<f64>) {
         let (rho, v) = self.density_and_wind_eci(t);
-        // C(q)ᵀ v for a not quite unit q, divided by |q|² (as in `magnetic_dipole`).
-        let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
-        let norm2 = w * w + u.norm_squared();
-        let rotated = (w * w - u.norm_squared()) * v + 2.0 * u.dot(&v) * u - 2.0 * w * u.cross(&v);
-        (rho, rotated / norm2)
+        (rho, to_body(q, &v))
     }
 
     /// The drag force −½ ρ |v_rel|² C_d A v̂_rel (N, in the axes of `wind`).
@@ -133,74 +129,25 @@ impl Aerodynamic {
     }
 }
 
-impl Effector for Aerodynamic {
+impl EnvironmentTorque for Aerodynamic {
     fn name(&self) -> &str {
         &self.name
     }
     fn kind(&self) -> &'static str {
         "aerodynamic"
     }
-    fn num_states(&self) -> usize {
-        1
-    }
-    fn num_dynamic_states(&self) -> usize {
-        0
-    }
-    fn state_names(&self) -> Vec<String> {
-        vec!["work".into()]
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        vec![0.0]
-    }
-    fn is_external(&self) -> bool {
-        true
-    }
-    fn scratch_len(&self) -> usize {
-        3
-    }
-    fn torque_only(&self) -> bool {
-        true
-    }
-    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        self.torque_at(hub.t, hub.attitude)
-    }
-    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let tau = self.torque_at(hub.t, hub.attitude);
-        coupling.add_torque(&tau);
-        scratch[..3].copy_from_slice(tau.as_slice());
-    }
-    fn derivatives(
-        &self,
-        hub: &HubState,
-        _accel: &HubAcceleration,
-        _x: &[f64],
-        scratch: &[f64],
-        dx: &mut [f64],
-    ) {
-        // Power of the torque on the hub: τ·ω.
-        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
-    }
-    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
-        Momentum::default()
-    }
-    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
-        EnergyAccount {
-            work: x[0],
-            ..EnergyAccount::default()
-        }
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.torque_at(t, q)
     }
     fn telemetry_names(&self) -> Vec<String> {
-        [
+        names(&[
             "torque_x", "torque_y", "torque_z", "density", "wind_x", "wind_y", "wind_z", "work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
-    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
-        let (rho, wind) = self.density_and_wind(hub.t, hub.attitude);
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+        let (rho, wind) = self.density_and_wind(t, q);
         let tau = self.center_of_pressure.cross(&self.force(rho, &wind));
-        vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], x[0]]
+        vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
     }
 }
 

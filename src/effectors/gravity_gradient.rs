@@ -15,9 +15,9 @@
 //! the effector carries one bookkeeping state, the work done on the body `W = ∫ τ·ω dt`
 //! (J), which the energy balance subtracts.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum};
+use super::environment::{EnvironmentTorque, names, to_body};
 use crate::orbit::Orbit;
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
 
 /// Gravity-gradient torque on a rigid hub in orbit.
@@ -37,15 +37,8 @@ impl GravityGradient {
     #[inline]
     pub fn torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
         let (r_hat_n, radius) = self.orbit.direction(t);
-        // C(q)ᵀ v for the integrated, not quite unit, quaternion q is |q|² times the rotated
-        // vector; the torque is quadratic in it, so dividing by |q|⁴ normalises exactly
-        // without a square root.
-        let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
-        let t_vec = 2.0 * u.cross(&r_hat_n);
-        let norm2 = w * w + u.norm_squared();
-        // v' = (w² − |u|²) v + 2 (u·v) u − 2 w (u × v): the inverse rotation, unnormalised.
-        let r_hat = (w * w - u.norm_squared()) * r_hat_n + 2.0 * u.dot(&r_hat_n) * u - w * t_vec;
-        let coefficient = 3.0 * self.orbit.body().mu / (radius * radius * radius * norm2 * norm2);
+        let r_hat = to_body(q, &r_hat_n);
+        let coefficient = 3.0 * self.orbit.body().mu / (radius * radius * radius);
         coefficient * r_hat.cross(&(self.inertia * r_hat))
     }
 
@@ -56,92 +49,35 @@ impl GravityGradient {
     /// conserved along an orbit (r̂ turns), so it is not part of the energy balance (the work
     /// `W` is).
     pub fn potential(&self, t: f64, q: &[f64]) -> f64 {
-        let (r, _) = self.orbit.state(t);
-        let attitude = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
-        let radius = r.norm();
-        let r_hat = attitude.inverse_transform_vector(&(r / radius));
+        let (r_hat_n, radius) = self.orbit.direction(t);
+        let r_hat = to_body(q, &r_hat_n);
         let mu_r3 = self.orbit.body().mu / (radius * radius * radius);
         0.5 * mu_r3 * (3.0 * r_hat.dot(&(self.inertia * r_hat)) - self.inertia.trace())
     }
 }
 
-impl Effector for GravityGradient {
+impl EnvironmentTorque for GravityGradient {
     fn name(&self) -> &str {
         &self.name
     }
     fn kind(&self) -> &'static str {
         "gravity_gradient"
     }
-    fn num_states(&self) -> usize {
-        1
-    }
-    fn num_dynamic_states(&self) -> usize {
-        0
-    }
-    fn state_names(&self) -> Vec<String> {
-        vec!["work".into()]
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        vec![0.0]
-    }
-    fn is_external(&self) -> bool {
-        true
-    }
-    fn scratch_len(&self) -> usize {
-        3
-    }
-    fn torque_only(&self) -> bool {
-        true
-    }
-    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        GravityGradient::torque(self, hub.t, hub.attitude)
-    }
-    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let tau = self.torque(hub.t, hub.attitude);
-        coupling.add_torque(&tau);
-        scratch[..3].copy_from_slice(tau.as_slice());
-    }
-    fn derivatives(
-        &self,
-        hub: &HubState,
-        _accel: &HubAcceleration,
-        _x: &[f64],
-        scratch: &[f64],
-        dx: &mut [f64],
-    ) {
-        // Power of the torque on the hub: τ·ω.
-        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
-    }
-    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
-        Momentum::default()
-    }
-    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
-        EnergyAccount {
-            work: x[0],
-            ..EnergyAccount::default()
-        }
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.torque(t, q)
     }
     fn telemetry_names(&self) -> Vec<String> {
-        [
+        names(&[
             "torque_x",
             "torque_y",
             "torque_z",
             "work",
             "potential_energy",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
-    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
-        let tau = self.torque(hub.t, hub.attitude);
-        vec![
-            tau[0],
-            tau[1],
-            tau[2],
-            x[0],
-            self.potential(hub.t, hub.attitude),
-        ]
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+        let tau = self.torque(t, q);
+        vec![tau[0], tau[1], tau[2], work, self.potential(t, q)]
     }
 }
 
@@ -149,6 +85,7 @@ impl Effector for GravityGradient {
 mod tests {
     use super::*;
     use crate::orbit::{CentralBody, Elements};
+    use nalgebra::UnitQuaternion;
 
     /// The square-root-free torque against the textbook evaluation with a normalised
     /// quaternion and the orbit's position, for a quaternion off unit norm by 1e-3, in a

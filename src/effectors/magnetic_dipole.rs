@@ -15,7 +15,7 @@
 //! `W = ∫ τ·ω dt` (J), which the energy balance subtracts. (The potential −m·B is not
 //! conserved: B turns in inertial space as the spacecraft moves and the Earth rotates.)
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum};
+use super::environment::{EnvironmentTorque, names, to_body};
 use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -40,14 +40,7 @@ impl MagneticDipole {
     pub fn field_body(&self, t: f64, q: &[f64]) -> Vector3<f64> {
         let (r_hat, radius) = self.orbit.direction(t);
         let b_n = self.field.field_eci(t, &r_hat, radius);
-        // C(q)ᵀ v for the integrated, not quite unit, quaternion q is |q|² times the rotated
-        // vector: v' = (w² − |u|²) v + 2 (u·v) u − 2 w (u × v). Dividing by |q|² normalises
-        // exactly, without a square root.
-        let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
-        let norm2 = w * w + u.norm_squared();
-        let rotated =
-            (w * w - u.norm_squared()) * b_n + 2.0 * u.dot(&b_n) * u - 2.0 * w * u.cross(&b_n);
-        rotated / norm2
+        to_body(q, &b_n)
     }
 
     /// The torque m × B (N m, body axes) at `t` for attitude `q`.
@@ -57,74 +50,25 @@ impl MagneticDipole {
     }
 }
 
-impl Effector for MagneticDipole {
+impl EnvironmentTorque for MagneticDipole {
     fn name(&self) -> &str {
         &self.name
     }
     fn kind(&self) -> &'static str {
         "magnetic_dipole"
     }
-    fn num_states(&self) -> usize {
-        1
-    }
-    fn num_dynamic_states(&self) -> usize {
-        0
-    }
-    fn state_names(&self) -> Vec<String> {
-        vec!["work".into()]
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        vec![0.0]
-    }
-    fn is_external(&self) -> bool {
-        true
-    }
-    fn scratch_len(&self) -> usize {
-        3
-    }
-    fn torque_only(&self) -> bool {
-        true
-    }
-    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        self.torque_at(hub.t, hub.attitude)
-    }
-    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let tau = self.torque_at(hub.t, hub.attitude);
-        coupling.add_torque(&tau);
-        scratch[..3].copy_from_slice(tau.as_slice());
-    }
-    fn derivatives(
-        &self,
-        hub: &HubState,
-        _accel: &HubAcceleration,
-        _x: &[f64],
-        scratch: &[f64],
-        dx: &mut [f64],
-    ) {
-        // Power of the torque on the hub: τ·ω.
-        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
-    }
-    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
-        Momentum::default()
-    }
-    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
-        EnergyAccount {
-            work: x[0],
-            ..EnergyAccount::default()
-        }
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.torque_at(t, q)
     }
     fn telemetry_names(&self) -> Vec<String> {
-        [
+        names(&[
             "torque_x", "torque_y", "torque_z", "b_x", "b_y", "b_z", "work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
-    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
-        let b = self.field_body(hub.t, hub.attitude);
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+        let b = self.field_body(t, q);
         let tau = self.moment.cross(&b);
-        vec![tau[0], tau[1], tau[2], b[0], b[1], b[2], x[0]]
+        vec![tau[0], tau[1], tau[2], b[0], b[1], b[2], work]
     }
 }
 

@@ -17,6 +17,7 @@
 pub mod aerodynamic;
 pub mod beam;
 pub mod energy_sink;
+pub mod environment;
 pub mod gravity_gradient;
 pub mod hinged_rod;
 pub mod magnetic_dipole;

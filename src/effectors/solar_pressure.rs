@@ -16,7 +16,7 @@
 //! torque about the hub's centre of mass is τ = r_cp × F. The torque is external, so the
 //! effector carries one bookkeeping state, the work done on the body W = ∫ τ·ω dt (J).
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum};
+use super::environment::{EnvironmentTorque, names, to_body};
 use crate::orbit::Orbit;
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -142,12 +142,7 @@ impl SolarPressure {
     /// inertial; normalised here).
     pub fn state_at(&self, t: f64, q: &[f64]) -> SolarState {
         let (s_n, d_au) = self.sun_eci(t);
-        // C(q)ᵀ s for the integrated, not quite unit, quaternion divided by |q|².
-        let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
-        let norm2 = w * w + u.norm_squared();
-        let s = ((w * w - u.norm_squared()) * s_n + 2.0 * u.dot(&s_n) * u
-            - 2.0 * w * u.cross(&s_n))
-            / norm2;
+        let s = to_body(q, &s_n);
         let illuminated = self.illuminated(t, &s_n);
         let force = if illuminated {
             self.plate_force(&s, SOLAR_PRESSURE_1AU / (d_au * d_au))
@@ -163,64 +158,18 @@ impl SolarPressure {
     }
 }
 
-impl Effector for SolarPressure {
+impl EnvironmentTorque for SolarPressure {
     fn name(&self) -> &str {
         &self.name
     }
     fn kind(&self) -> &'static str {
         "solar_pressure"
     }
-    fn num_states(&self) -> usize {
-        1
-    }
-    fn num_dynamic_states(&self) -> usize {
-        0
-    }
-    fn state_names(&self) -> Vec<String> {
-        vec!["work".into()]
-    }
-    fn initial_state(&self) -> Vec<f64> {
-        vec![0.0]
-    }
-    fn is_external(&self) -> bool {
-        true
-    }
-    fn scratch_len(&self) -> usize {
-        3
-    }
-    fn torque_only(&self) -> bool {
-        true
-    }
-    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        self.state_at(hub.t, hub.attitude).torque
-    }
-    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let tau = self.state_at(hub.t, hub.attitude).torque;
-        coupling.add_torque(&tau);
-        scratch[..3].copy_from_slice(tau.as_slice());
-    }
-    fn derivatives(
-        &self,
-        hub: &HubState,
-        _accel: &HubAcceleration,
-        _x: &[f64],
-        scratch: &[f64],
-        dx: &mut [f64],
-    ) {
-        // Power of the torque on the hub: τ·ω.
-        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
-    }
-    fn momentum(&self, _hub: &HubState, _x: &[f64]) -> Momentum {
-        Momentum::default()
-    }
-    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
-        EnergyAccount {
-            work: x[0],
-            ..EnergyAccount::default()
-        }
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.state_at(t, q).torque
     }
     fn telemetry_names(&self) -> Vec<String> {
-        [
+        names(&[
             "torque_x",
             "torque_y",
             "torque_z",
@@ -229,13 +178,10 @@ impl Effector for SolarPressure {
             "sun_z",
             "illuminated",
             "work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
-    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
-        let st = self.state_at(hub.t, hub.attitude);
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+        let st = self.state_at(t, q);
         vec![
             st.torque[0],
             st.torque[1],
@@ -244,7 +190,7 @@ impl Effector for SolarPressure {
             st.sun_body[1],
             st.sun_body[2],
             if st.illuminated { 1.0 } else { 0.0 },
-            x[0],
+            work,
         ]
     }
 }

@@ -1,0 +1,103 @@
+//! What the environmental torques (gravity gradient, magnetic dipole, aerodynamic, solar
+//! pressure) share: one [`Effector`] implementation over an [`EnvironmentTorque`] model, and
+//! the rotation of an inertial vector into body axes by the integrated quaternion.
+//!
+//! Each such torque is external and torque-only, and carries one bookkeeping state: the work
+//! it has done on the hub, W = ∫ τ·ω dt (J), which the energy balance subtracts. A model
+//! states only its name, kind, torque and telemetry.
+
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use nalgebra::Vector3;
+use std::fmt::Debug;
+
+/// An environmental torque on the hub, a function of time and attitude only.
+pub trait EnvironmentTorque: Debug + Send + Sync {
+    /// Unique name (telemetry topic).
+    fn name(&self) -> &str;
+    /// The kind as written in YAML.
+    fn kind(&self) -> &'static str;
+    /// The torque (N m, body axes) at time `t` (s) for the integrated attitude `q` (w, x, y,
+    /// z; body → inertial; not quite unit).
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64>;
+    /// Names of its telemetry fields (`work` among them; units in `log::units`).
+    fn telemetry_names(&self) -> Vec<String>;
+    /// Telemetry values at `t`, `q`, with the work done so far `work` (J), in the order of
+    /// [`EnvironmentTorque::telemetry_names`].
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64>;
+}
+
+/// C(q)ᵀ v: the inertial vector `v` in body axes, for the integrated, not quite unit,
+/// quaternion `q` (w, x, y, z). For such a q, (w² − |u|²) v + 2 (u·v) u − 2 w (u × v) is |q|²
+/// times the rotated vector; dividing by |q|² normalises exactly, without a square root.
+#[inline]
+pub fn to_body(q: &[f64], v: &Vector3<f64>) -> Vector3<f64> {
+    let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
+    let u2 = u.norm_squared();
+    ((w * w - u2) * v + 2.0 * u.dot(v) * u - 2.0 * w * u.cross(v)) / (w * w + u2)
+}
+
+impl<T: EnvironmentTorque> Effector for T {
+    fn name(&self) -> &str {
+        EnvironmentTorque::name(self)
+    }
+    fn kind(&self) -> &'static str {
+        EnvironmentTorque::kind(self)
+    }
+    fn num_states(&self) -> usize {
+        1
+    }
+    fn num_dynamic_states(&self) -> usize {
+        0
+    }
+    fn state_names(&self) -> Vec<String> {
+        vec!["work".into()]
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        vec![0.0]
+    }
+    fn is_external(&self) -> bool {
+        true
+    }
+    fn scratch_len(&self) -> usize {
+        3
+    }
+    fn torque_only(&self) -> bool {
+        true
+    }
+    fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
+        self.environment_torque(hub.t, hub.attitude)
+    }
+    fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
+        let tau = self.environment_torque(hub.t, hub.attitude);
+        coupling.add_torque(&tau);
+        scratch[..3].copy_from_slice(tau.as_slice());
+    }
+    fn derivatives(
+        &self,
+        hub: &HubState,
+        _accel: &HubAcceleration,
+        _x: &[f64],
+        scratch: &[f64],
+        dx: &mut [f64],
+    ) {
+        // Power of the torque on the hub: τ·ω (the torque is the scratch).
+        dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
+    }
+    fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
+        EnergyAccount {
+            work: x[0],
+            ..EnergyAccount::default()
+        }
+    }
+    fn telemetry_names(&self) -> Vec<String> {
+        EnvironmentTorque::telemetry_names(self)
+    }
+    fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
+        EnvironmentTorque::telemetry(self, hub.t, hub.attitude, x[0])
+    }
+}
+
+/// Field names from string literals.
+pub fn names(fields: &[&str]) -> Vec<String> {
+    fields.iter().map(|s| s.to_string()).collect()
+}
