@@ -568,18 +568,21 @@ pub(super) fn build(
                     }
                 })
         };
+        // Environmental torques need the orbit.
+        let needs_orbit = || {
+            cx.orbit.clone().ok_or_else(|| {
+                ScenarioError::at(
+                    cx.path,
+                    item,
+                    ck.prefix.clone(),
+                    "an environmental torque needs the spacecraft's orbit: add an `orbit:` \
+                     block (semi_major_axis_km or perigee/apogee altitudes, inclination_deg, …)",
+                )
+            })
+        };
         match spec {
             EffectorSpec::GravityGradient(g) => {
-                let Some(orbit) = &cx.orbit else {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        item,
-                        ck.prefix.clone(),
-                        "an environmental torque needs the spacecraft's orbit: add an \
-                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
-                         inclination_deg, …)",
-                    ));
-                };
+                let orbit = &needs_orbit()?;
                 out.push(Box::new(crate::effectors::GravityGradient {
                     name: name_of(&g.name),
                     orbit: orbit.clone(),
@@ -587,16 +590,7 @@ pub(super) fn build(
                 }));
             }
             EffectorSpec::MagneticDipole(m) => {
-                let Some(orbit) = &cx.orbit else {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        item,
-                        ck.prefix.clone(),
-                        "an environmental torque needs the spacecraft's orbit: add an \
-                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
-                         inclination_deg, …)",
-                    ));
-                };
+                let orbit = &needs_orbit()?;
                 let v = Vector3::from(m.moment.value);
                 if !v.iter().all(|c| c.is_finite()) || v.norm() > MAX_DIPOLE_MOMENT {
                     return Err(ck.err(
@@ -637,16 +631,7 @@ pub(super) fn build(
                 }));
             }
             EffectorSpec::SolarPressure(sp) => {
-                let Some(orbit) = &cx.orbit else {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        item,
-                        ck.prefix.clone(),
-                        "an environmental torque needs the spacecraft's orbit: add an \
-                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
-                         inclination_deg, …)",
-                    ));
-                };
+                let orbit = &needs_orbit()?;
                 let area = ck.positive(&sp.area, "area", "m²")?;
                 let n = Vector3::from(sp.normal.value);
                 if !n.iter().all(|c| c.is_finite()) || n.norm() < MIN_POSITIVE {
@@ -725,16 +710,7 @@ pub(super) fn build(
                 }));
             }
             EffectorSpec::Aerodynamic(a) => {
-                let Some(orbit) = &cx.orbit else {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        item,
-                        ck.prefix.clone(),
-                        "an environmental torque needs the spacecraft's orbit: add an \
-                         `orbit:` block (semi_major_axis_km or perigee/apogee altitudes, \
-                         inclination_deg, …)",
-                    ));
-                };
+                let orbit = &needs_orbit()?;
                 let cd = a.drag_coefficient.value;
                 if !(cd > 0.0 && cd <= MAX_DRAG_COEFFICIENT) {
                     return Err(ck.err(
