@@ -3,17 +3,18 @@
 //! Atmosphere 1976 evaluated here from its defining equations, the relative wind and the
 //! torque worked out by hand, the work–energy balance of a tumbling CubeSat, and the located
 //! errors.
+mod common;
+
+use common::run;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use polhode::effectors::Aerodynamic;
 use polhode::effectors::aerodynamic::density;
-use polhode::model::Observation;
 use polhode::orbit::{CentralBody, Elements, Orbit};
 use polhode::scenario::{Overrides, Scenario, parse};
-use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Status};
+use polhode::sim::Status;
 use std::path::Path;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
 /// WGS-84 GM (m³/s²), equatorial radius (m) and rotation rate (rad/s), NIMA TR8350.2 Table 3.1.
 const MU: f64 = 3.986_004_418e14;
@@ -233,21 +234,6 @@ fn the_torque_is_zero_with_the_centre_of_pressure_at_the_centre_of_mass() {
     }
 }
 
-#[derive(Default)]
-struct Recorder {
-    samples: Vec<(f64, f64)>,
-}
-
-impl Sink for Recorder {
-    fn sample(&mut self, o: &Observation, _: &[f64], _: &Reference) -> std::io::Result<()> {
-        self.samples.push((o.energy_balance(), o.kinetic_energy));
-        Ok(())
-    }
-    fn event(&mut self, _: &EventRecord, _: &Observation) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 fn load(yaml: &str) -> Scenario {
     parse(
         Path::new("aero.yaml"),
@@ -255,21 +241,6 @@ fn load(yaml: &str) -> Scenario {
         &Overrides::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(s: &Scenario) -> (Outcome, Recorder) {
-    let mut rec = Recorder::default();
-    let stop = AtomicBool::new(false);
-    let out = sim::run(
-        s,
-        &mut rec,
-        Control {
-            interrupt: &stop,
-            progress: None,
-        },
-    )
-    .unwrap();
-    (out, rec)
 }
 
 /// A 3U CubeSat tumbling at 350 km, 51.6°, with its centre of pressure 2 cm off the centre
@@ -289,13 +260,20 @@ effectors:
     let s = load(yaml);
     let (out, rec) = run(&s);
     assert_eq!(out.status, Status::Complete);
-    let (e0, t0) = rec.samples[0];
+    let (e0, t0) = (
+        rec.samples[0].energy_balance(),
+        rec.samples[0].kinetic_energy,
+    );
     let mut worst: f64 = 0.0;
     let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for (e, t) in &rec.samples {
+    for (e, t) in rec
+        .samples
+        .iter()
+        .map(|o| (o.energy_balance(), o.kinetic_energy))
+    {
         worst = worst.max((e - e0).abs() / t0);
-        lo = lo.min(*t);
-        hi = hi.max(*t);
+        lo = lo.min(t);
+        hi = hi.max(t);
     }
     eprintln!(
         "T - W drift {worst:e} of T0, T spread {:e} of T0",

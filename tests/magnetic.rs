@@ -3,17 +3,18 @@
 //! pure dipole's pole and equator strengths, the Earth rotation angle evaluated here from
 //! its IERS definition, the geometry of m × B, the work–energy balance of a tumbling CubeSat,
 //! and the located errors.
+mod common;
+
+use common::run;
 
 use nalgebra::{UnitQuaternion, Vector3};
 use polhode::effectors::MagneticDipole;
-use polhode::model::Observation;
 use polhode::orbit::magnetic::{Dipole, REFERENCE_RADIUS};
 use polhode::orbit::{CentralBody, Elements, GeomagneticField, Orbit};
 use polhode::scenario::{Overrides, Scenario, parse};
-use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Status};
+use polhode::sim::Status;
 use std::path::Path;
 use std::sync::Arc;
-use std::sync::atomic::AtomicBool;
 
 /// IGRF-14 DGRF 2020.0 first-degree coefficients (nT), typed from the IAGA coefficient file.
 const G10: f64 = -29403.41;
@@ -160,22 +161,6 @@ fn the_torque_is_perpendicular_to_the_moment_and_the_field() {
     }
 }
 
-#[derive(Default)]
-struct Recorder {
-    samples: Vec<(f64, Vec<f64>, f64, f64)>,
-}
-
-impl Sink for Recorder {
-    fn sample(&mut self, o: &Observation, y: &[f64], _: &Reference) -> std::io::Result<()> {
-        self.samples
-            .push((o.t, y.to_vec(), o.energy_balance(), o.kinetic_energy));
-        Ok(())
-    }
-    fn event(&mut self, _: &EventRecord, _: &Observation) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 fn load(yaml: &str) -> Scenario {
     parse(
         Path::new("mag.yaml"),
@@ -183,21 +168,6 @@ fn load(yaml: &str) -> Scenario {
         &Overrides::default(),
     )
     .unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn run(s: &Scenario) -> (Outcome, Recorder) {
-    let mut rec = Recorder::default();
-    let stop = AtomicBool::new(false);
-    let out = sim::run(
-        s,
-        &mut rec,
-        Control {
-            interrupt: &stop,
-            progress: None,
-        },
-    )
-    .unwrap();
-    (out, rec)
 }
 
 /// A 3U CubeSat tumbling at 500 km, 51.6°, with a 0.05 A m² residual dipole, for two
@@ -218,13 +188,20 @@ effectors:
     let s = load(yaml);
     let (out, rec) = run(&s);
     assert_eq!(out.status, Status::Complete);
-    let (_, _, e0, t0) = rec.samples[0];
+    let (e0, t0) = (
+        rec.samples[0].energy_balance(),
+        rec.samples[0].kinetic_energy,
+    );
     let mut worst: f64 = 0.0;
     let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for (_, _, e, t) in &rec.samples {
+    for (e, t) in rec
+        .samples
+        .iter()
+        .map(|o| (o.energy_balance(), o.kinetic_energy))
+    {
         worst = worst.max((e - e0).abs() / t0);
-        lo = lo.min(*t);
-        hi = hi.max(*t);
+        lo = lo.min(t);
+        hi = hi.max(t);
     }
     eprintln!(
         "T - W drift {worst:e} of T0, T spread {:e} of T0",
