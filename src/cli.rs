@@ -145,7 +145,8 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
-    /// Eigenvalues of the linearisation about steady spin about the spin axis.
+    /// Eigenvalues of the linearisation about steady spin about the spin axis (with a
+    /// gravity gradient in a circular orbit: about the LVLH equilibrium).
     Linearize {
         /// Scenario YAML file.
         scenario: PathBuf,
@@ -701,6 +702,29 @@ fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
         Ok(s) => s,
         Err(c) => return c,
     };
+    if crate::linearize::lvlh::applies(&s.spacecraft) {
+        // A gravity-gradient spacecraft in orbit: about its LVLH equilibrium.
+        let lin = match crate::linearize::lvlh::linearize_scenario(&s) {
+            Ok(l) => l,
+            Err(m) => {
+                eprintln!("error: {}: {m}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+        };
+        let text = serde_json::to_string_pretty(&lin).unwrap_or_default();
+        match json {
+            Some(p) if p == Path::new("-") => println!("{text}"),
+            Some(p) => {
+                if let Err(e) = write_atomically(p, text.as_bytes()) {
+                    eprintln!("error: cannot write {}: {e}", p.display());
+                    return EXIT_BAD_INPUT;
+                }
+                print!("{}", lin.report(&s.name));
+            }
+            None => print!("{}", lin.report(&s.name)),
+        }
+        return 0;
+    }
     if let Some(motion) = s.spacecraft.motion() {
         // A driven hub: the effectors' modes at the rate the motion reaches at the end.
         let omega = motion.omega(s.duration);

@@ -28,6 +28,11 @@
 //! energy ΔE = T − h²/(2 I_s) of the nutation decay (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is
 //! good for well-damped dampers only (and not given for a gyrostat, whose energy function
 //! differs); the eigenvalue is the reference.
+//!
+//! A gravity-gradient spacecraft in a circular orbit is linearised instead about its
+//! LVLH-fixed equilibrium: [`lvlh`].
+
+pub mod lvlh;
 
 use crate::effectors::EnergySink;
 use crate::integrate::OdeSystem;
