@@ -1666,6 +1666,8 @@ const ALL_KEYS: &[&str] = &[
     "diffuse",
     "aerodynamic",
     "drag_coefficient",
+    "from_shape",
+    "shape_center",
 ];
 
 impl Valid {

@@ -1,5 +1,6 @@
 //! `aerodynamic`: the torque of atmospheric drag on the hub, for a constant projected area
-//! with a fixed centre of pressure.
+//! with a fixed centre of pressure ([`Aerodynamic`]), or on the facets of the body's shape
+//! ([`ShapeAerodynamic`], with the surface of [`facets`]).
 //!
 //! With ρ the density at the spacecraft's altitude, v_rel the velocity of the spacecraft's
 //! centre of mass relative to the co-rotating atmosphere and r_cp the centre of pressure
@@ -17,8 +18,11 @@
 //! the wind in body axes. The torque is external, so the effector carries one bookkeeping
 //! state, the work done on the body `W = ∫ τ·ω dt` (J), which the energy balance subtracts.
 
+pub mod facets;
+
 use super::environment::{EnvironmentTorque, names, to_body};
 use crate::orbit::Orbit;
+use facets::DragSurface;
 use nalgebra::Vector3;
 use std::sync::Arc;
 
@@ -78,6 +82,19 @@ pub fn density(h: f64) -> f64 {
     rho0 * (-(km - h0) / scale).exp()
 }
 
+/// The density (kg/m³) at the altitude of `orbit` at `t` (s), and the velocity relative to
+/// the co-rotating atmosphere v − ω_E × r (m/s, ECI).
+#[inline]
+pub fn density_and_wind_eci(orbit: &Orbit, t: f64) -> (f64, Vector3<f64>) {
+    let (r, v) = orbit.state(t);
+    let body = orbit.body();
+    let rho = density(r.norm() - body.radius);
+    // ω_E × r with ω_E = ω_E ẑ.
+    let w = body.rotation_rate;
+    let wind = v - Vector3::new(-w * r.y, w * r.x, 0.0);
+    (rho, wind)
+}
+
 /// Drag on the hub with a constant projected area and a fixed centre of pressure.
 #[derive(Debug, Clone)]
 pub struct Aerodynamic {
@@ -98,13 +115,7 @@ impl Aerodynamic {
     /// co-rotating atmosphere v − ω_E × r (m/s, ECI).
     #[inline]
     pub fn density_and_wind_eci(&self, t: f64) -> (f64, Vector3<f64>) {
-        let (r, v) = self.orbit.state(t);
-        let body = self.orbit.body();
-        let rho = density(r.norm() - body.radius);
-        // ω_E × r with ω_E = ω_E ẑ.
-        let w = body.rotation_rate;
-        let wind = v - Vector3::new(-w * r.y, w * r.x, 0.0);
-        (rho, wind)
+        density_and_wind_eci(&self.orbit, t)
     }
 
     /// The density (kg/m³) and the relative velocity v_rel (m/s, body axes) at `t` for the
@@ -147,6 +158,80 @@ impl EnvironmentTorque for Aerodynamic {
     fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
         let (rho, wind) = self.density_and_wind(t, q);
         let tau = self.center_of_pressure.cross(&self.force(rho, &wind));
+        vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
+    }
+}
+
+/// Drag on the facets of the body's shape: the projected area and the centre of pressure
+/// follow the attitude. With w = v_rel in body axes and ŵ = w/|w|,
+///
+/// ```text
+/// F = −½ ρ |w|² C_d A_p(ŵ) ŵ,   τ = Σ c_i × F_i = −½ ρ |w|² C_d M(ŵ) × ŵ
+/// ```
+///
+/// with A_p and M the projected area and its first moment of [`DragSurface::projection`].
+#[derive(Debug, Clone)]
+pub struct ShapeAerodynamic {
+    /// Name (telemetry topic).
+    pub name: String,
+    /// The orbit of the spacecraft's centre of mass.
+    pub orbit: Arc<Orbit>,
+    /// Drag coefficient C_d of every facet (dimensionless).
+    pub drag_coefficient: f64,
+    /// The surface (body axes, about the hub's centre of mass).
+    pub surface: DragSurface,
+}
+
+impl ShapeAerodynamic {
+    /// The density (kg/m³) and the relative velocity v_rel (m/s, body axes) at `t` for the
+    /// attitude `q` (w, x, y, z; body → inertial; normalised here).
+    #[inline]
+    pub fn density_and_wind(&self, t: f64, q: &[f64]) -> (f64, Vector3<f64>) {
+        let (rho, v) = density_and_wind_eci(&self.orbit, t);
+        (rho, to_body(q, &v))
+    }
+
+    /// The drag force F (N) and torque τ (N m) for the density `rho` (kg/m³) and the
+    /// relative velocity `wind` (m/s), both in body axes; zero in still air.
+    #[inline]
+    pub fn force_and_torque(&self, rho: f64, wind: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let speed = wind.norm();
+        if speed == 0.0 {
+            return (Vector3::zeros(), Vector3::zeros());
+        }
+        let w_hat = wind / speed;
+        let (area, moment) = self.surface.projection(&w_hat);
+        // −½ ρ |w|² C_d ŵ = −½ ρ |w| C_d w.
+        let k = -0.5 * rho * self.drag_coefficient * speed;
+        (k * area * wind, k * moment.cross(wind))
+    }
+
+    /// The torque Σ c_i × F_i (N m, body axes) at `t` for attitude `q`.
+    #[inline]
+    pub fn torque_at(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        let (rho, wind) = self.density_and_wind(t, q);
+        self.force_and_torque(rho, &wind).1
+    }
+}
+
+impl EnvironmentTorque for ShapeAerodynamic {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn kind(&self) -> &'static str {
+        "aerodynamic"
+    }
+    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
+        self.torque_at(t, q)
+    }
+    fn telemetry_names(&self) -> Vec<String> {
+        names(&[
+            "torque_x", "torque_y", "torque_z", "density", "wind_x", "wind_y", "wind_z", "work",
+        ])
+    }
+    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+        let (rho, wind) = self.density_and_wind(t, q);
+        let tau = self.force_and_torque(rho, &wind).1;
         vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
     }
 }

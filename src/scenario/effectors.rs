@@ -41,8 +41,9 @@ pub enum EffectorSpec {
     Aerodynamic(AerodynamicSpec),
 }
 
-/// `aerodynamic:` — drag on a constant projected area, acting at a fixed centre of pressure,
-/// in the exponential atmosphere of Vallado's Table 8-4.
+/// `aerodynamic:` — drag in the exponential atmosphere of Vallado's Table 8-4, either on a
+/// constant projected area at a fixed centre of pressure (`area`, `center_of_pressure`), or
+/// on the facets of `body.shape` (`from_shape: true`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AerodynamicSpec {
@@ -52,9 +53,19 @@ pub struct AerodynamicSpec {
     /// Drag coefficient C_d (dimensionless; 2.2 is customary in LEO).
     pub drag_coefficient: Spanned<f64>,
     /// Projected area A (m²), the same for every attitude.
-    pub area: Spanned<f64>,
+    #[serde(default)]
+    pub area: Option<Spanned<f64>>,
     /// Centre of pressure (m, body axes, about the hub's centre of mass).
-    pub center_of_pressure: Spanned<[f64; 3]>,
+    #[serde(default)]
+    pub center_of_pressure: Option<Spanned<[f64; 3]>>,
+    /// `true`: drag on the facets of `body.shape`, whose projected area and centre of
+    /// pressure follow the attitude, instead of `area` and `center_of_pressure`.
+    #[serde(default)]
+    pub from_shape: Option<Spanned<bool>>,
+    /// With `from_shape`, where the centre of `body.shape` is (m, body axes, about the centre
+    /// of mass; default the centre of mass).
+    #[serde(default)]
+    pub shape_center: Option<Spanned<[f64; 3]>>,
 }
 
 /// Largest `aerodynamic` drag coefficient: free-molecular flat plates and spheres are 2 to 3.
@@ -723,28 +734,115 @@ pub(super) fn build(
                         ),
                     ));
                 }
-                let area = ck.positive(&a.area, "area", "m²")?;
-                let cp = Vector3::from(a.center_of_pressure.value);
-                if !cp.iter().all(|c| c.is_finite()) || cp.norm() > MAX_CENTER_OF_PRESSURE {
-                    return Err(ck.err(
-                        &a.center_of_pressure,
-                        "center_of_pressure",
-                        format!(
-                            "expected three finite numbers within {MAX_CENTER_OF_PRESSURE:e} m \
-                             of the centre of mass (m, body axes), got [{}, {}, {}]",
-                            a.center_of_pressure.value[0],
-                            a.center_of_pressure.value[1],
-                            a.center_of_pressure.value[2]
-                        ),
-                    ));
+                let arm = |s: &Spanned<[f64; 3]>, key: &str| {
+                    let p = Vector3::from(s.value);
+                    if p.iter().all(|c| c.is_finite()) && p.norm() <= MAX_CENTER_OF_PRESSURE {
+                        Ok(p)
+                    } else {
+                        Err(ck.err(
+                            s,
+                            key,
+                            format!(
+                                "expected three finite numbers within \
+                                 {MAX_CENTER_OF_PRESSURE:e} m of the centre of mass (m, body \
+                                 axes), got [{}, {}, {}]",
+                                s.value[0], s.value[1], s.value[2]
+                            ),
+                        ))
+                    }
+                };
+                let name = name_of(&a.name);
+                match (&a.from_shape, &a.area, &a.center_of_pressure) {
+                    (Some(f), area, cp) if f.value => {
+                        if let Some(s) = area {
+                            return Err(ck.err(
+                                s,
+                                "area",
+                                "with `from_shape: true` the projected area follows from \
+                                 `body.shape` and the attitude: remove `area`, or \
+                                 `from_shape` for a constant area",
+                            ));
+                        }
+                        if let Some(s) = cp {
+                            return Err(ck.err(
+                                s,
+                                "center_of_pressure",
+                                "with `from_shape: true` the centre of pressure follows from \
+                                 `body.shape` and the attitude: remove `center_of_pressure` \
+                                 (`shape_center` places the shape relative to the centre of \
+                                 mass)",
+                            ));
+                        }
+                        let Some(shape) = cx.shape else {
+                            return Err(ck.err(
+                                f,
+                                "from_shape",
+                                "drag on the body's facets needs `body.shape`: a box \
+                                 `{box: {size: [x, y, z]}}` or a cylinder `{cylinder: \
+                                 {radius: r, length: l, axis: [0, 0, 1]}}` (m, body axes)",
+                            ));
+                        };
+                        let center = match &a.shape_center {
+                            Some(s) => arm(s, "shape_center")?,
+                            None => Vector3::zeros(),
+                        } + cx.shift;
+                        use crate::effectors::aerodynamic::facets::DragSurface;
+                        let surface = match shape {
+                            Shape::Box { size, orientation } => {
+                                DragSurface::cuboid(*size, orientation, center)
+                            }
+                            Shape::Cylinder {
+                                radius,
+                                length,
+                                orientation,
+                            } => DragSurface::cylinder(*radius, *length, orientation, center),
+                        };
+                        out.push(Box::new(crate::effectors::aerodynamic::ShapeAerodynamic {
+                            name,
+                            orbit: orbit.clone(),
+                            drag_coefficient: cd,
+                            surface,
+                        }));
+                    }
+                    (_, Some(area), Some(cp)) => {
+                        if let Some(s) = &a.shape_center {
+                            return Err(ck.err(
+                                s,
+                                "shape_center",
+                                "`shape_center` places `body.shape` for `from_shape: true`; \
+                                 with a constant `area` the drag acts at `center_of_pressure`",
+                            ));
+                        }
+                        let area = ck.positive(area, "area", "m²")?;
+                        let cp = arm(cp, "center_of_pressure")?;
+                        out.push(Box::new(crate::effectors::Aerodynamic {
+                            name,
+                            orbit: orbit.clone(),
+                            drag_coefficient: cd,
+                            area,
+                            center_of_pressure: cp + cx.shift,
+                        }));
+                    }
+                    (_, Some(_), None) => {
+                        return Err(ScenarioError::at(
+                            cx.path,
+                            item,
+                            ck.prefix.clone(),
+                            "missing field `center_of_pressure`: a constant `area` acts at a \
+                             fixed centre of pressure (m, body axes, about the centre of mass)",
+                        ));
+                    }
+                    (_, None, _) => {
+                        return Err(ScenarioError::at(
+                            cx.path,
+                            item,
+                            ck.prefix.clone(),
+                            "expected `area` (m²) and `center_of_pressure` (m, body axes) for a \
+                             constant projected area, or `from_shape: true` for drag on the \
+                             facets of `body.shape`",
+                        ));
+                    }
                 }
-                out.push(Box::new(crate::effectors::Aerodynamic {
-                    name: name_of(&a.name),
-                    orbit: orbit.clone(),
-                    drag_coefficient: cd,
-                    area,
-                    center_of_pressure: cp,
-                }));
             }
             EffectorSpec::Rayleigh(r) => {
                 let gamma = match (&r.gamma, &r.gamma_diagonal) {
