@@ -208,6 +208,56 @@ def block_basilisk(bsk):
     return "\n".join(lines)
 
 
+def vec_cell(v, digits=6):
+    return "(" + ", ".join(f"{x:.{digits - 1}e}" for x in v) + ")"
+
+
+ENV_TITLES = {"gravity_gradient": ("Gravity gradient", "GravityGradientEffector"),
+              "magnetic_dipole": ("Magnetic dipole", "MagneticFieldCenteredDipole + MtbEffector"),
+              "aerodynamic": ("Aerodynamic", "ExponentialAtmosphere + ZeroWindModel + FacetDragDynamicEffector"),
+              "solar_pressure": ("Solar pressure", "FacetSRPDynamicEffector + Eclipse")}
+
+
+def env_context(kind, fed):
+    """A short column of what Basilisk computed on the way (the state's scale)."""
+    if kind == "gravity_gradient":
+        return f"r = {sum(x * x for x in fed['r_eci']) ** 0.5 / 1e3:.1f} km"
+    if kind == "magnetic_dipole":
+        b = sum(x * x for x in fed["b_eci"]) ** 0.5
+        return f"{fed['decimal_year']:.3f}, \\|B\\| = {b * 1e6:.2f} µT"
+    if kind == "aerodynamic":
+        return f"h = {fed['altitude'] / 1e3:.1f} km, ρ = {fed['density']:.4e} kg/m³"
+    return f"shadow factor {fed['shadow_factor']:g}, {fed['sun_distance_au']:.5f} AU"
+
+
+def block_environment(bsk_env, pol_env):
+    if bsk_env is None or pol_env is None:
+        return "_Not run (see below)._"
+    lines = [f"Basilisk (bsk) {bsk_env['basilisk']}, generated {bsk_env['generated']}; torques in N m, "
+             f"body axes; relative difference \\|τ_polhode − τ_Basilisk\\| / \\|τ_Basilisk\\| "
+             f"(0 where both are exactly zero); the test's tolerance is {pol_env['tolerance']:.0e}."]
+    for kind, (title, modules) in ENV_TITLES.items():
+        fed = bsk_env["effectors"][kind]
+        rows = pol_env["effectors"][kind]
+        lines += ["", f"**{title}** ({modules})", "",
+                  "| state | Basilisk computed | Basilisk torque | polhode torque | relative difference |",
+                  "|---|---|---|---|---|"]
+        for f_row, p_row in zip(fed, rows):
+            assert f_row["input"]["label"] == p_row["label"], (f_row["input"]["label"], p_row["label"])
+            lines.append(f"| {p_row['label']} | {env_context(kind, f_row['basilisk'])} | "
+                         f"{vec_cell(p_row['basilisk'])} | {vec_cell(p_row['polhode'])} | "
+                         f"{p_row['relative_difference']:.1e} |")
+    return "\n".join(lines)
+
+
+def load_optional(name):
+    path = os.path.join(RESULTS, name)
+    if not os.path.exists(path):
+        return None
+    with open(path) as fh:
+        return json.load(fh)
+
+
 def replace_block(text, name, content):
     pat = re.compile(rf"(<!-- generated:{name} -->).*?(<!-- /generated:{name} -->)", re.S)
     if not pat.search(text):
@@ -225,6 +275,8 @@ def main():
     if os.path.exists(bp):
         with open(bp) as fh:
             bsk = json.load(fh)
+    bsk_env, pol_env = (load_optional(n) for n in ("basilisk_environment.json",
+                                                   "basilisk_environment_polhode.json"))
     # Ratios afresh from the runs (so a change of method here needs no re-run).
     sys.path.insert(0, HERE)
     from bench import compute_ratios
@@ -234,7 +286,7 @@ def main():
     blocks = {"versions": block_versions(summary, bsk), "problems": block_problems(summary),
               "refcheck": block_refcheck(summary), "headline": block_headline(summary, runs),
               "target": block_target(summary), "runs": block_runs(summary, runs),
-              "basilisk": block_basilisk(bsk)}
+              "basilisk": block_basilisk(bsk), "environment": block_environment(bsk_env, pol_env)}
     for name, content in blocks.items():
         text = replace_block(text, name, content)
     with open(DOC, "w") as fh:

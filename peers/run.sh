@@ -46,6 +46,11 @@ if [[ $report_only == 0 ]]; then
   "$VENV/bin/python" "$PEERS/bench.py"
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
+    "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
+  # polhode's environmental torques at the states of results/basilisk_environment.json.
+  echo "[run] polhode's environmental torques at Basilisk's states (tests/basilisk_environment.rs)"
+  (cd "$ROOT" && POLHODE_PEER_OUT="$PEERS/results/basilisk_environment_polhode.json" \
+    cargo test --release --locked --quiet --test basilisk_environment)
 fi
 "$VENV/bin/python" "$PEERS/report.py"
