@@ -252,10 +252,67 @@ fn bench_environment_rhs(repeats: usize) {
     }
 }
 
+/// What aerodynamic drag adds to a rigid body's right-hand side: one constant area, and the
+/// facets of a box and of a cylinder (`from_shape: true`), in LEO.
+fn bench_drag_rhs(repeats: usize) {
+    let yaml = |shape: &str, drag: &str| {
+        format!(
+            "name: b\nbody: {{principal: [3, 5, 7]{shape}}}\n\
+             orbit: {{semi_major_axis_km: 6778.137, inclination_deg: 51.6}}\n\
+             initial: {{omega: [0.01, 0.02, 0.03]}}\nduration: 1\n\
+             effectors:\n  - aerodynamic: {{drag_coefficient: 2.2, {drag}}}\n"
+        )
+    };
+    let load = |text: String| {
+        scenario::parse(Path::new("bench.yaml"), text, &Overrides::default()).expect("scenario")
+    };
+    let calls = 20_000;
+    let rigid = load(
+        "name: b\nbody: {principal: [3, 5, 7]}\ninitial: {omega: [0.01, 0.02, 0.03]}\n\
+         duration: 1\n"
+            .into(),
+    );
+    println!("\naerodynamic drag, one right-hand-side evaluation against the rigid body:");
+    let from_shape = "from_shape: true, shape_center: [0, 0.02, 0.01]";
+    for (label, shape, drag) in [
+        (
+            "one area",
+            "",
+            "area: 0.03, center_of_pressure: [0, 0.02, 0.01]",
+        ),
+        (
+            "box facets",
+            ", shape: {box: {size: [1, 1.4, 1.8]}}",
+            from_shape,
+        ),
+        (
+            "cylinder",
+            ", shape: {cylinder: {radius: 0.8, length: 1.8}}",
+            from_shape,
+        ),
+    ] {
+        let with = load(yaml(shape, drag));
+        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
+        let mut f_base = time_rhs(&rigid, calls);
+        let mut f = time_rhs(&with, calls);
+        for _ in 0..repeats {
+            base_best = base_best.min(min_time(1, &mut f_base));
+            best = best.min(min_time(1, &mut f));
+        }
+        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
+        println!(
+            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
+            ns - base_ns,
+            ns / base_ns
+        );
+    }
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 15 };
     bench_environment_rhs(repeats);
+    bench_drag_rhs(repeats);
     bench_effector_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(
