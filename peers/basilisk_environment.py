@@ -19,7 +19,7 @@ the comparison isolates the torque computation (each is recorded in the JSON and
 notes of docs/peers.md):
 - the orbit state: position and velocity from the elements with Basilisk's orbitalMotion
   (f -> E -> M, M + n t, M -> E -> f, elem2rv), mu = 3.986004418e14 m^3/s^2 (polhode's,
-  WGS-84) instead of Basilisk's 3.986004415e14;
+  WGS-84) instead of Basilisk's createEarth() 3.98600436e14;
 - the dipole: the IGRF-14 first-degree coefficients at the decimal year of the instant
   (typed below from the IGRF-14 coefficient file, linear between the 5-yearly snapshots,
   secular variation after 2025), reference radius 6371.2 km, and the Earth rotation angle
