@@ -37,7 +37,8 @@ pub enum EffectorSpec {
     MagneticDipole(MagneticDipoleSpec),
     /// Solar radiation pressure on a flat plate (needs `orbit:`).
     SolarPressure(SolarPressureSpec),
-    /// Drag on a constant projected area with a fixed centre of pressure (needs `orbit:`).
+    /// Drag on a constant projected area with a fixed centre of pressure, or on the facets of
+    /// `body.shape` (needs `orbit:`).
     Aerodynamic(AerodynamicSpec),
 }
 
