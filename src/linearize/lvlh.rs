@@ -435,10 +435,13 @@ pub fn linearize_lvlh(
         .fold(0.0, f64::max);
     if equilibrium_residual > 1e-9 {
         return Err(format!(
-            "the LVLH attitude with the principal axes on the LVLH axes is not an equilibrium \
-             of this spacecraft (residual {equilibrium_residual:.3e} relative to n and n²): an \
-             effector or the gravity-gradient inertia differs from the whole spacecraft's \
-             principal axes"
+            "the LVLH attitude with the principal axes on the LVLH axes and the effectors at \
+             rest is not an equilibrium of this spacecraft (residual \
+             {equilibrium_residual:.3e} relative to n and n²): an effector is pushed at rest \
+             (a damper's mass pulled by the tidal force, a spring preloaded), or the inertia \
+             the gravity gradient acts on has other principal axes than the whole \
+             spacecraft's; the equilibrium then lies elsewhere, and this linearisation does \
+             not solve for it"
         ));
     }
     let step = |j: usize| match j {
