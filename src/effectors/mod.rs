@@ -9,7 +9,8 @@
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
-//! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure.
+//! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure,
+//!   and [`aerodynamic::ShapeAerodynamic`] on the facets of the body's shape.
 //!
 //! The three mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
