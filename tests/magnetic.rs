@@ -109,7 +109,7 @@ fn the_dipole_is_twice_as_strong_at_its_poles_as_on_its_equator() {
 /// 2010, eq. 5.15): at 2020-01-01T00:00Z, D_U = 7304.5 d.
 #[test]
 fn the_inertial_field_turns_with_the_earth() {
-    let epoch_ns = 1_577_836_800_000_000_000u64;
+    let epoch_ns = 1_577_836_800_000_000_000i64;
     let field = GeomagneticField::new(epoch_ns);
     let dipole = Dipole::igrf14(2020.0);
     for t in [0.0f64, 3600.0] {

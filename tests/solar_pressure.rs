@@ -93,7 +93,7 @@ fn the_sun_is_nearest_in_january_and_farthest_in_july() {
     }
 }
 
-const EPOCH_JUNE_SOLSTICE_NS: u64 = 1_718_916_660_000_000_000; // 2024-06-20T20:51Z
+const EPOCH_JUNE_SOLSTICE_NS: i64 = 1_718_916_660_000_000_000; // 2024-06-20T20:51Z
 
 fn plate(orbit: Orbit, normal: Vector3<f64>, r_cp: Vector3<f64>) -> SolarPressure {
     SolarPressure {

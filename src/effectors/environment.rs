@@ -7,7 +7,7 @@
 //! states only its name, kind, torque and telemetry.
 
 use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 
 /// An environmental torque on the hub, a function of time and attitude only.
@@ -24,6 +24,15 @@ pub trait EnvironmentTorque: Debug + Send + Sync {
     /// Telemetry values at `t`, `q`, with the work done so far `work` (J), in the order of
     /// [`EnvironmentTorque::telemetry_names`].
     fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64>;
+    /// The gradient of its field (1/s², body axes) at `t`, `q`, when the field also acts on
+    /// the masses other effectors move ([`Effector::tidal_gradient`]); `None` otherwise.
+    fn tidal_gradient(&self, _t: f64, _q: &[f64]) -> Option<Matrix3<f64>> {
+        None
+    }
+    /// Whether [`EnvironmentTorque::tidal_gradient`] gives a field.
+    fn acts_on_moving_masses(&self) -> bool {
+        false
+    }
 }
 
 /// C(q)ᵀ v: the inertial vector `v` in body axes, for the integrated, not quite unit,
@@ -58,6 +67,12 @@ impl<T: EnvironmentTorque> Effector for T {
     fn is_external(&self) -> bool {
         true
     }
+    fn acts_on_moving_masses(&self) -> bool {
+        EnvironmentTorque::acts_on_moving_masses(self)
+    }
+    fn tidal_gradient(&self, hub: &HubState) -> Option<Matrix3<f64>> {
+        EnvironmentTorque::tidal_gradient(self, hub.t, hub.attitude)
+    }
     fn scratch_len(&self) -> usize {
         3
     }
@@ -75,13 +90,17 @@ impl<T: EnvironmentTorque> Effector for T {
     fn derivatives(
         &self,
         hub: &HubState,
-        _accel: &HubAcceleration,
+        accel: &HubAcceleration,
         _x: &[f64],
         scratch: &[f64],
         dx: &mut [f64],
     ) {
-        // Power of the torque on the hub: τ·ω (the torque is the scratch).
+        // Power of the torque on the hub: τ·ω (the torque is the scratch), plus that of the
+        // field on the moving masses when it acts on them.
         dx[0] = scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
+        if EnvironmentTorque::acts_on_moving_masses(self) {
+            dx[0] += accel.tidal_power;
+        }
     }
     fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
         EnergyAccount {

@@ -42,6 +42,17 @@ impl GravityGradient {
         coefficient * r_hat.cross(&(self.inertia * r_hat))
     }
 
+    /// The gradient of the central body's field at the orbit position, in body axes (1/s²):
+    /// G = (μ/r³)(3 r̂ r̂ᵀ − 1), so that a mass m displaced by ρ from the centre of mass
+    /// feels the tidal force m G ρ to first order in ρ/r (Hughes 1986, §8.1). Its moment
+    /// summed over a rigid body, ∫ ρ × G ρ dm, is [`GravityGradient::torque`].
+    pub fn gradient(&self, t: f64, q: &[f64]) -> Matrix3<f64> {
+        let (r_hat_n, radius) = self.orbit.direction(t);
+        let r_hat = to_body(q, &r_hat_n);
+        let mu_r3 = self.orbit.body().mu / (radius * radius * radius);
+        mu_r3 * (3.0 * r_hat * r_hat.transpose() - Matrix3::identity())
+    }
+
     /// The attitude-dependent part of the hub's gravitational potential energy (J) at `t`
     /// for attitude `q`, from MacCullagh's formula U = −μm/r − (μ/2r³)(tr I − 3 r̂ᵀ I r̂):
     /// V = (μ / 2r³)(3 r̂ᵀ I r̂ − tr I) (Hughes 1986, §8.1). The torque is −∂V/∂(attitude)
@@ -65,6 +76,12 @@ impl EnvironmentTorque for GravityGradient {
     }
     fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
         self.torque(t, q)
+    }
+    fn acts_on_moving_masses(&self) -> bool {
+        true
+    }
+    fn tidal_gradient(&self, t: f64, q: &[f64]) -> Option<Matrix3<f64>> {
+        Some(self.gradient(t, q))
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[

@@ -243,6 +243,7 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
         let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
         let mut pt = ParticlePoint::default();
         let cache = self.model.prepare(q, u);
+        let mut tidal = coupling.tidal;
         for p in 0..self.model.num_particles() {
             self.model.particle(p, &cache, q, u, &mut pt);
             let m = pt.mass;
@@ -251,6 +252,24 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             let mut v_rel = Vector3::zeros();
             for (k, j) in jac.iter().enumerate() {
                 v_rel += j * u[k];
+            }
+            if let Some(field) = &mut tidal {
+                // The gravity gradient's tidal force on this particle: an external force on
+                // the coordinates (Jᵀ f) and on the system (f, r × f).
+                let f = m * (field.gradient * r);
+                for k in 0..n {
+                    g[k] += jac[k].dot(&f);
+                }
+                let moment = r.cross(&f);
+                for i in 0..3 {
+                    coupling.force[i] += f[i];
+                    coupling.force[3 + i] += moment[i];
+                }
+                let v = w.cross(&r) + v_rel;
+                field.relative_power += f.dot(&v);
+                field.first_moment += m * r;
+                field.relative_momentum += m * v;
+                field.moving_mass += m;
             }
             let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
             for k in 0..n {
@@ -274,6 +293,7 @@ impl<P: ParticleModel> Effector for ParticleEffector<P> {
             e_t += m * c;
             e_r += m * r.cross(&c);
         }
+        coupling.tidal = tidal;
         let mut forces = [0.0; MAX_COORDINATES];
         self.model.forces(q, u, &mut forces[..n]);
         for k in 0..n {

@@ -79,7 +79,7 @@ pub struct SolarPressure {
     /// The orbit of the spacecraft's centre of mass (for the shadow).
     pub orbit: Arc<Orbit>,
     /// The scenario epoch (Unix ns, UTC) of simulation time 0.
-    pub epoch_unix_ns: u64,
+    pub epoch_unix_ns: i64,
     /// Plate area A (m²).
     pub area: f64,
     /// Unit normal n̂ of the plate's sunlit face (body axes).

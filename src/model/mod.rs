@@ -46,6 +46,53 @@ pub struct HubCoupling {
     /// Set by effectors that move mass relative to the hub: the translational block must be
     /// solved too. Otherwise `a_B = 0` and only the rotational block is solved.
     pub translation: bool,
+    /// A gravity gradient acting on the moving masses too (scenes with both); `None`
+    /// otherwise.
+    pub tidal: Option<TidalCoupling>,
+}
+
+/// The gravity gradient's field on the masses that move relative to the hub, and what those
+/// masses report back for its work.
+///
+/// Each moving particle of mass m at r (about B, body axes) feels the tidal force
+/// `f = m G r`, with `G = (μ/r_o³)(3 r̂ r̂ᵀ − 1)` the gradient of the central body's field at
+/// the orbit position r_o (body axes). Taking the expansion about B rather than about the
+/// system's centre of mass c leaves out a force `−m G c` uniform in acceleration, which
+/// changes only the solved a_B, not the rotation or the coordinates (docs/environment.md,
+/// "Gravity gradient on moving masses").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TidalCoupling {
+    /// The gradient G (1/s², body axes).
+    pub gradient: Matrix3<f64>,
+    /// Σ f·(ω × r + ṙ) over the moving particles (W): their tidal power relative to B.
+    pub relative_power: f64,
+    /// Σ m r over the moving particles (kg m, body axes).
+    pub first_moment: Vector3<f64>,
+    /// Σ m (ω × r + ṙ) over the moving particles (kg m/s, body axes).
+    pub relative_momentum: Vector3<f64>,
+    /// Σ m over the moving particles (kg).
+    pub moving_mass: f64,
+}
+
+impl TidalCoupling {
+    /// No moving mass yet in the field `gradient`.
+    pub fn new(gradient: Matrix3<f64>) -> TidalCoupling {
+        TidalCoupling {
+            gradient,
+            relative_power: 0.0,
+            first_moment: Vector3::zeros(),
+            relative_momentum: Vector3::zeros(),
+            moving_mass: 0.0,
+        }
+    }
+
+    /// The tidal forces' power on the moving masses (W) in the frame of the system's centre
+    /// of mass, where the total momentum is zero: Σ f·v with v = v_B + ω × r + ṙ and
+    /// v_B = −Σ m (ω × r + ṙ) / (hub mass + moving mass).
+    pub fn power(&self, hub_mass: f64) -> f64 {
+        let v_hub = -self.relative_momentum / (hub_mass + self.moving_mass);
+        self.relative_power + (self.gradient * self.first_moment).dot(&v_hub)
+    }
 }
 
 impl HubCoupling {
@@ -65,6 +112,9 @@ pub struct HubAcceleration {
     pub linear: Vector3<f64>,
     /// Angular acceleration ω̇, body axes (rad/s²).
     pub angular: Vector3<f64>,
+    /// Power of the gravity gradient on the moving masses (W; [`TidalCoupling::power`]), for
+    /// the gravity-gradient effector's work; 0 without it.
+    pub tidal_power: f64,
 }
 
 impl HubAcceleration {
@@ -207,6 +257,17 @@ pub trait Effector: Debug + Send + Sync {
     fn is_external(&self) -> bool {
         false
     }
+    /// Whether its field also acts on the masses other effectors move (the gravity
+    /// gradient): then [`Effector::tidal_gradient`] gives it, and its work includes
+    /// [`HubAcceleration::tidal_power`].
+    fn acts_on_moving_masses(&self) -> bool {
+        false
+    }
+    /// The gradient G of its field (1/s², body axes) at the hub state, for the tidal force
+    /// `m G r` on a moving particle at r ([`TidalCoupling`]).
+    fn tidal_gradient(&self, _hub: &HubState) -> Option<Matrix3<f64>> {
+        None
+    }
     /// Whether its [`Effector::couple`] only adds a torque: nothing in the mass matrix, no
     /// translation. A scene of such effectors solves the hub with its constant inverse
     /// inertia instead of the general coupled system.
@@ -222,6 +283,7 @@ pub trait Effector: Debug + Send + Sync {
             mass: Matrix6::zeros(),
             force: Vector6::zeros(),
             translation: false,
+            tidal: None,
         };
         let mut scratch = vec![0.0; self.scratch_len()];
         self.couple(hub, x, &mut coupling, &mut scratch);
@@ -323,6 +385,9 @@ pub struct Spacecraft {
     translation: bool,
     /// Every effector is [`Effector::torque_only`] (and there is at least one).
     torque_only: bool,
+    /// The effector whose field acts on the moving masses too, when some effector moves
+    /// mass ([`Effector::acts_on_moving_masses`]).
+    tidal_source: Option<usize>,
     dim: usize,
 }
 
@@ -347,6 +412,7 @@ impl Spacecraft {
             scratch_len: 0,
             translation: false,
             torque_only: false,
+            tidal_source: None,
             dim: HUB_STATES,
         }
     }
@@ -369,6 +435,15 @@ impl Spacecraft {
                 )));
             }
             self.translation = true;
+        }
+        if effector.acts_on_moving_masses() {
+            if self.tidal_source.is_some() {
+                return Err(AddEffectorError(format!(
+                    "effector `{}`: a scene takes one gravity gradient",
+                    effector.name()
+                )));
+            }
+            self.tidal_source = Some(self.effectors.len());
         }
         self.torque_only =
             effector.torque_only() && (self.effectors.is_empty() || self.torque_only);
@@ -520,6 +595,10 @@ impl Spacecraft {
             mass,
             force: Vector6::new(0.0, 0.0, 0.0, gyro[0], gyro[1], gyro[2]),
             translation: self.translation,
+            tidal: self.tidal_source.and_then(|k| {
+                let gradient = self.effectors[k].tidal_gradient(hub)?;
+                Some(TidalCoupling::new(gradient))
+            }),
         };
         for (k, e) in self.effectors.iter().enumerate() {
             let off = self.offsets[k];
@@ -556,6 +635,7 @@ impl Spacecraft {
         let accel = HubAcceleration {
             linear: Vector3::zeros(),
             angular: self.hub.inertia_inv * total,
+            tidal_power: 0.0,
         };
         for (k, e) in self.effectors.iter().enumerate() {
             let off = self.offsets[k];
@@ -593,7 +673,10 @@ impl Spacecraft {
                 scratch.resize(self.scratch_len, 0.0);
             }
             let coupling = self.coupling(&hub, y, &mut scratch);
-            let accel = solve(&coupling);
+            let mut accel = solve(&coupling);
+            if let Some(tidal) = &coupling.tidal {
+                accel.tidal_power = tidal.power(self.hub_mass.unwrap_or(0.0));
+            }
             for (k, e) in self.effectors.iter().enumerate() {
                 let off = self.offsets[k];
                 let n = e.num_states();
@@ -640,6 +723,7 @@ impl Spacecraft {
             HubAcceleration {
                 linear,
                 angular: wd,
+                tidal_power: 0.0,
             }
         });
         dydt[..3].copy_from_slice(omega_dot.as_slice());
@@ -705,10 +789,12 @@ fn solve_hub(c: &HubCoupling) -> HubAcceleration {
             Some(z) => HubAcceleration {
                 linear: Vector3::new(z[0], z[1], z[2]),
                 angular: Vector3::new(z[3], z[4], z[5]),
+                tidal_power: 0.0,
             },
             None => HubAcceleration {
                 linear: Vector3::repeat(f64::NAN),
                 angular: Vector3::repeat(f64::NAN),
+                tidal_power: 0.0,
             },
         }
     } else {
@@ -720,6 +806,7 @@ fn solve_hub(c: &HubCoupling) -> HubAcceleration {
                 .try_inverse()
                 .map(|inv| inv * f_r)
                 .unwrap_or_else(|| Vector3::repeat(f64::NAN)),
+            tidal_power: 0.0,
         }
     }
 }
@@ -759,6 +846,7 @@ impl OdeSystem for Spacecraft {
             self.effector_rhs(t, y, dydt, |c| HubAcceleration {
                 linear: Vector3::zeros(),
                 angular: inverse * Vector3::new(c.force[3], c.force[4], c.force[5]),
+                tidal_power: 0.0,
             })
         } else {
             self.effector_rhs(t, y, dydt, solve_hub)

@@ -13,8 +13,8 @@ const J2000_UNIX_NS: i64 = 946_728_000_000_000_000;
 const NS_PER_DAY: i64 = 86_400_000_000_000;
 
 /// UT1 days since J2000.0 as `(whole days, fraction)`, with the whole part exact.
-fn days_since_j2000(epoch_unix_ns: u64, t: f64) -> (f64, f64) {
-    let d_ns = epoch_unix_ns as i64 - J2000_UNIX_NS;
+fn days_since_j2000(epoch_unix_ns: i64, t: f64) -> (f64, f64) {
+    let d_ns = epoch_unix_ns - J2000_UNIX_NS;
     let whole = d_ns.div_euclid(NS_PER_DAY);
     let rem_ns = d_ns.rem_euclid(NS_PER_DAY);
     let frac = (rem_ns as f64 * 1e-9 + t) / 86_400.0;
@@ -34,7 +34,7 @@ fn days_since_j2000(epoch_unix_ns: u64, t: f64) -> (f64, f64) {
 /// ([`gmst_iau82`]) also carries the accumulated precession in right ascension
 /// (≈ 4612″ per century, 0.32° by 2025). Use the ERA unless matching Vallado's
 /// equinox-based examples.
-pub fn earth_rotation_angle(epoch_unix_ns: u64, t: f64) -> f64 {
+pub fn earth_rotation_angle(epoch_unix_ns: i64, t: f64) -> f64 {
     let (whole, frac) = days_since_j2000(epoch_unix_ns, t);
     let turns = 0.779_057_273_264_0 + frac + 0.002_737_811_911_354_48 * (whole + frac);
     TAU * turns.rem_euclid(1.0)
@@ -47,7 +47,7 @@ pub fn earth_rotation_angle(epoch_unix_ns: u64, t: f64) -> f64 {
 ///
 /// `876600 h · T` is `86400 s · D_U` exactly, of which only the day fraction contributes
 /// modulo one day; it is evaluated that way to keep precision.
-pub fn gmst_iau82(epoch_unix_ns: u64, t: f64) -> f64 {
+pub fn gmst_iau82(epoch_unix_ns: i64, t: f64) -> f64 {
     let (whole, frac) = days_since_j2000(epoch_unix_ns, t);
     let tc = (whole + frac) / 36_525.0;
     let seconds = 67_310.548_41

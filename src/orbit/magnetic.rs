@@ -148,12 +148,12 @@ pub fn decimal_year(unix_s: f64) -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeomagneticField {
     /// The scenario epoch (Unix ns, UTC) of simulation time 0.
-    pub epoch_unix_ns: u64,
+    pub epoch_unix_ns: i64,
 }
 
 impl GeomagneticField {
     /// The field for a run starting at `epoch_unix_ns`.
-    pub fn new(epoch_unix_ns: u64) -> GeomagneticField {
+    pub fn new(epoch_unix_ns: i64) -> GeomagneticField {
         GeomagneticField { epoch_unix_ns }
     }
 

@@ -101,6 +101,8 @@ pub const MAX_PRESSURE_ARM: f64 = 1e3;
 /// Unix time (s) of 2050-01-01T00:00Z, the end of the span of the low-precision solar
 /// coordinates (1950–2050).
 pub const SOLAR_EPHEMERIS_END_UNIX_S: f64 = 2_524_608_000.0;
+/// 1950-01-01T00:00:00Z as Unix seconds: the start of the same span.
+pub const SOLAR_EPHEMERIS_START_UNIX_S: f64 = -631_152_000.0;
 
 /// `magnetic_dipole:` — a constant (residual) dipole moment on the hub in the first-degree
 /// IGRF field of the Earth.
@@ -539,7 +541,7 @@ pub(super) struct Context<'a> {
     pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
     /// The scenario epoch (Unix ns, UTC) of simulation time 0, and where `epoch:` is written
     /// (None for the default).
-    pub epoch_unix_ns: u64,
+    pub epoch_unix_ns: i64,
     pub epoch_loc: Option<(u32, u32)>,
 }
 
@@ -701,13 +703,14 @@ pub(super) fn build(
                         ),
                     ));
                 }
-                if cx.epoch_unix_ns as f64 * 1e-9 >= SOLAR_EPHEMERIS_END_UNIX_S {
+                let epoch_s = cx.epoch_unix_ns as f64 * 1e-9;
+                if !(SOLAR_EPHEMERIS_START_UNIX_S..SOLAR_EPHEMERIS_END_UNIX_S).contains(&epoch_s) {
                     return Err(ScenarioError::at(
                         cx.path,
                         cx.epoch_loc.or(item),
                         "epoch",
                         "the low-precision solar coordinates (Vallado Algorithm 29) hold from \
-                         1950 to 2050: choose an epoch before 2050-01-01",
+                         1950 to 2050: choose an epoch from 1950-01-01 to before 2050-01-01",
                     ));
                 }
                 out.push(Box::new(crate::effectors::SolarPressure {
@@ -1114,26 +1117,6 @@ pub(super) fn build(
                 }
             }
         }
-    }
-    // The gravity gradient acts on the hub's inertia only: on moving masses it would need
-    // each particle's tidal force, which is not modelled yet.
-    if let Some(i) = specs
-        .iter()
-        .position(|s| matches!(s.value, EffectorSpec::GravityGradient(_)))
-        && let Some(mover) = out.iter().find(|e| e.moves_mass())
-    {
-        return Err(ScenarioError::at(
-            cx.path,
-            loc(&specs[i]),
-            format!("effectors[{i}].gravity_gradient"),
-            format!(
-                "the gravity-gradient torque is modelled on the rigid hub only, and `{}` moves \
-                 mass relative to it (the tidal force on each moving particle is not modelled \
-                 yet): use `body.composite` mass properties with a torque-only scene, or leave \
-                 the gravity gradient out",
-                mover.name()
-            ),
-        ));
     }
     // The energy sink is the quasi-rigid model: its Ĥ is the hub's Iω, so it keeps |H| only
     // when no other effector carries momentum.

@@ -13,7 +13,7 @@ mod time;
 pub use effectors::{EffectorSpec, HubMotionSpec};
 
 pub use error::{ScenarioError, field_path_at, nearest};
-pub use time::{LAST_LOG_SECOND, format_epoch, parse_epoch};
+pub use time::{LAST_LOG_SECOND, format_epoch, log_origin, parse_epoch};
 
 use crate::model::{RigidBody, Spacecraft};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
@@ -616,8 +616,8 @@ pub struct Scenario {
     pub name: String,
     /// `description:`.
     pub description: String,
-    /// Sim time 0 as Unix time (ns).
-    pub epoch_unix_ns: u64,
+    /// Sim time 0 as Unix time (ns; negative before 1970).
+    pub epoch_unix_ns: i64,
     /// The spacecraft (hub and effectors).
     pub spacecraft: Spacecraft,
     /// Initial body rates (rad/s).
@@ -1649,8 +1649,9 @@ impl ScenarioFile {
             None => parse_epoch(DEFAULT_EPOCH).expect("the default epoch parses"),
             Some(e) => parse_epoch(&e.value).map_err(|m| err(loc(e), "epoch", m))?,
         };
-        // The log's time stamps (epoch + sim time) must fit Foxglove's 32-bit seconds.
-        let end_s = epoch_unix_ns as f64 * 1e-9 + duration;
+        // The log's time stamps (epoch, or 1970 for an earlier epoch, + sim time) must fit
+        // Foxglove's 32-bit seconds.
+        let end_s = log_origin(epoch_unix_ns) as f64 * 1e-9 + duration;
         if end_s >= LAST_LOG_SECOND as f64 {
             return Err(err(
                 duration_loc,

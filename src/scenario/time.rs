@@ -30,10 +30,15 @@ fn civil_from_days(z: i64) -> (i64, i64, i64) {
 /// as `u32` (2106-02-07T06:28:16Z).
 pub const LAST_LOG_SECOND: u64 = 1 << 32;
 
-/// Parses `YYYY-MM-DDTHH:MM:SS[.fraction]Z` (UTC) to Unix time in nanoseconds.
+/// First year an epoch may have: the environment models' tables (IGRF) start in 1900.
+pub const FIRST_EPOCH_YEAR: i64 = 1900;
+
+/// Parses `YYYY-MM-DDTHH:MM:SS[.fraction]Z` (UTC) to Unix time in nanoseconds (negative
+/// before 1970), for years from [`FIRST_EPOCH_YEAR`] until 2106-02-07T06:28:16Z.
 ///
-/// MCAP log times are unsigned, so epochs before 1970 are refused with an explanation.
-pub fn parse_epoch(text: &str) -> Result<u64, String> {
+/// MCAP log times are unsigned nanoseconds since 1970: a run whose epoch precedes 1970 is
+/// stamped from 1970-01-01T00:00:00Z instead (see [`log_origin`]).
+pub fn parse_epoch(text: &str) -> Result<i64, String> {
     let expected = "expected a UTC date-time like `2000-01-01T12:00:00Z` (RFC 3339, ending in Z)";
     let s = text.trim();
     let bad = || format!("`{s}` is not a valid date-time: {expected}");
@@ -79,14 +84,13 @@ pub fn parse_epoch(text: &str) -> Result<u64, String> {
     if !(1..=12).contains(&mo) || d < 1 || d > max_day || h > 23 || mi > 59 || sec > 59 {
         return Err(bad());
     }
-    if y < 1970 {
+    if y < FIRST_EPOCH_YEAR {
         return Err(format!(
-            "`{s}` is before 1970-01-01: MCAP log times are unsigned nanoseconds since 1970, \
-             so the epoch must be 1970 or later (use a modern stand-in date and say so in the \
-             description)"
+            "`{s}` is before {FIRST_EPOCH_YEAR}-01-01: the environment models (the IGRF field, \
+             the Earth's rotation) are tabulated from {FIRST_EPOCH_YEAR}; choose a later epoch"
         ));
     }
-    let nanos: u64 = if frac.is_empty() {
+    let nanos: i64 = if frac.is_empty() {
         0
     } else {
         format!("{frac:0<9}").parse().map_err(|_| bad())?
@@ -98,13 +102,20 @@ pub fn parse_epoch(text: &str) -> Result<u64, String> {
              run must stay before 2106-02-07T06:28:16Z"
         ));
     }
-    Ok(secs as u64 * 1_000_000_000 + nanos)
+    Ok(secs * 1_000_000_000 + nanos)
 }
 
-/// Formats Unix nanoseconds as `YYYY-MM-DDTHH:MM:SS.nnnnnnnnnZ`.
-pub fn format_epoch(unix_ns: u64) -> String {
-    let secs = (unix_ns / 1_000_000_000) as i64;
-    let nanos = unix_ns % 1_000_000_000;
+/// The log time (Unix ns) of simulation time 0 for an epoch `epoch_unix_ns`: the epoch
+/// itself from 1970 on; 0 (1970-01-01T00:00:00Z) for an earlier epoch, whose instants MCAP's
+/// unsigned log times cannot hold. The log's metadata keeps the true epoch either way.
+pub fn log_origin(epoch_unix_ns: i64) -> u64 {
+    u64::try_from(epoch_unix_ns).unwrap_or(0)
+}
+
+/// Formats Unix nanoseconds (negative before 1970) as `YYYY-MM-DDTHH:MM:SS.nnnnnnnnnZ`.
+pub fn format_epoch(unix_ns: i64) -> String {
+    let secs = unix_ns.div_euclid(1_000_000_000);
+    let nanos = unix_ns.rem_euclid(1_000_000_000);
     let (y, m, d) = civil_from_days(secs.div_euclid(86400));
     let rem = secs.rem_euclid(86400);
     format!(
@@ -135,13 +146,27 @@ mod tests {
             format_epoch(946_728_000_000_000_000),
             "2000-01-01T12:00:00.000000000Z"
         );
+        // Explorer 1's launch: 1958-01-01 is 12·365 + 3 leap days = 4383 days before
+        // 1970-01-01, and February 1st 31 days after it.
+        let launch = -(4383 - 31) * 86_400 + 3 * 3600 + 47 * 60 + 56;
+        assert_eq!(
+            parse_epoch("1958-02-01T03:47:56.25Z"),
+            Ok(launch * 1_000_000_000 + 250_000_000)
+        );
+        assert_eq!(
+            format_epoch(launch * 1_000_000_000 + 250_000_000),
+            "1958-02-01T03:47:56.250000000Z"
+        );
+        assert_eq!(log_origin(launch * 1_000_000_000), 0);
+        assert_eq!(log_origin(5), 5);
     }
 
     #[test]
     fn round_trip_over_many_days() {
-        // Every representable epoch: 1970 to just before 2106-02-07 (2^32 s).
-        for day in (0..49_710).step_by(37) {
-            let ns = day as u64 * 86_400_000_000_000 + 12_345_678_901;
+        // Every accepted epoch: 1900-01-01 (25 567 days before 1970) to just before
+        // 2106-02-07 (2^32 s).
+        for day in (-25_567..49_710).step_by(37) {
+            let ns = day as i64 * 86_400_000_000_000 + 12_345_678_901;
             assert_eq!(parse_epoch(&format_epoch(ns)), Ok(ns));
         }
     }
@@ -153,7 +178,7 @@ mod tests {
             "2000-13-01T00:00:00Z",
             "2000-01-01",
             "2000-01-01T00:00:00",
-            "1958-02-01T03:48:00Z",
+            "1899-12-31T23:59:59Z",
             "2000-01-01T24:00:00Z",
             "2106-02-07T06:28:16Z",
         ] {
