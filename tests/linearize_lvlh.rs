@@ -225,6 +225,58 @@ fn the_nearest_equilibrium_to_the_initial_attitude_is_taken() {
     assert_matches_closed_form(&lin, permuted, 1e-9, "turned 93° about pitch");
 }
 
+/// A full inertia tensor whose principal axes are turned 0.3 rad about (1, 2, 3) from the body
+/// axes, I = R diag(6, 8, 3) Rᵀ, started with the body axes on LVLH: the equilibrium has the
+/// principal axes R e_k on roll, pitch, yaw (0.3 rad = 17.19° away), moments (6, 8, 3), and
+/// the closed-form eigenvalues of those moments.
+#[test]
+fn a_full_inertia_tensor_is_linearised_about_its_principal_axes() {
+    let axis = nalgebra::Unit::new_normalize(Vector3::new(1.0, 2.0, 3.0));
+    let r = nalgebra::Rotation3::from_axis_angle(&axis, 0.3);
+    let inertia = r.matrix()
+        * nalgebra::Matrix3::from_diagonal(&Vector3::new(6.0, 8.0, 3.0))
+        * r.matrix().transpose();
+    let rows: Vec<String> = (0..3)
+        .map(|i| {
+            format!(
+                "[{:e}, {:e}, {:e}]",
+                inertia[(i, 0)],
+                inertia[(i, 1)],
+                inertia[(i, 2)]
+            )
+        })
+        .collect();
+    let yaml = scene(
+        [1.0, 1.0, 1.0],
+        7000.0,
+        TURNED,
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0; 3],
+        1.0,
+        "",
+    )
+    .replace(
+        "body: {principal: [1, 1, 1]}",
+        &format!("body: {{inertia: [{}]}}", rows.join(", ")),
+    );
+    assert!(yaml.contains("inertia:"), "{yaml}");
+    let lin = linearize_yaml(&yaml).unwrap();
+    assert!(
+        (lin.initial_offset_deg - 0.3f64.to_degrees()).abs() < 1e-9,
+        "{lin:#?}"
+    );
+    for (k, want) in [6.0, 8.0, 3.0].into_iter().enumerate() {
+        assert!((lin.moments[k] - want).abs() < 1e-12, "{lin:#?}");
+        let principal = r * Vector3::ith(k, 1.0);
+        let got = Vector3::from(lin.body_axes_on_lvlh[k]);
+        assert!(
+            (got.dot(&principal).abs() - 1.0).abs() < 1e-12,
+            "axis {k}: {got:?} vs {principal:?}"
+        );
+    }
+    assert_matches_closed_form(&lin, [6.0, 8.0, 3.0], 1e-9, "full tensor");
+}
+
 /// The LVLH frame of a circular equatorial orbit at t, built here from its definition: the
 /// orbit starts on ECI x and moves toward +y, so r̂ = (cos nt, sin nt, 0), o3 = −r̂,
 /// o2 = −ẑ, o1 = o2 × o3.
