@@ -17,7 +17,7 @@ pub mod telemetry;
 pub mod units;
 
 use crate::model::{Drawing, HubState, Observation, Spacecraft};
-use crate::scenario::{Compression, Scenario, Shape, format_epoch};
+use crate::scenario::{Compression, Scenario, Shape, format_epoch, log_origin};
 use crate::sim::{EventRecord, Outcome, Reference, Sink};
 use foxglove::Encode;
 use foxglove::messages as fg;
@@ -360,7 +360,7 @@ impl<'a> McapLogger<'a> {
             writer,
             temp,
             final_path: path.to_path_buf(),
-            epoch_ns: scenario.epoch_unix_ns,
+            epoch_ns: log_origin(scenario.epoch_unix_ns),
             channels,
             sequence: 0,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
@@ -396,7 +396,7 @@ impl<'a> McapLogger<'a> {
             writer,
             temp,
             final_path,
-            epoch_ns: scenario.epoch_unix_ns,
+            epoch_ns: log_origin(scenario.epoch_unix_ns),
             channels,
             sequence,
             scene: SceneStyle::of(scenario, outcome_ref_omega),
@@ -413,7 +413,8 @@ impl<'a> McapLogger<'a> {
         &self.final_path
     }
 
-    /// Log time (Unix ns) of sim time `t`. Validation keeps epoch + duration below 2^32 s,
+    /// Log time (Unix ns) of sim time `t`, from the log origin (the epoch, or 1970-01-01 for
+    /// an earlier epoch). Validation keeps origin + duration below 2^32 s,
     /// so this neither overflows nor saturates for `0 ≤ t ≤ duration`.
     fn log_time(&self, t: f64) -> u64 {
         self.epoch_ns
@@ -473,7 +474,11 @@ impl<'a> McapLogger<'a> {
         meta.insert("scenario".into(), scenario.name.clone());
         meta.insert("scenario_file".into(), scenario.path.display().to_string());
         meta.insert("integrator".into(), method.into());
-        meta.insert("epoch".into(), format_epoch(self.epoch_ns));
+        meta.insert("epoch".into(), format_epoch(scenario.epoch_unix_ns));
+        if scenario.epoch_unix_ns < 0 {
+            // MCAP log times are unsigned: an epoch before 1970 is stamped from 1970.
+            meta.insert("log_time_origin".into(), format_epoch(self.epoch_ns as i64));
+        }
         meta.insert(
             "quaternion_convention".into(),
             "Hamilton; body to world (v_world = q v_body q*); /tf stores x,y,z,w; \
