@@ -417,6 +417,102 @@ fn dissipation_damps_lagrange_and_destabilises_debra_delp() {
     }
 }
 
+/// A pitch libration damper: a spring–mass–dashpot (m = 0.1 kg on a 13 kg hub, reduced mass
+/// μ = mM/(m + M)) at d = 1 m along yaw (nadir), sliding along roll, with the gravity gradient
+/// on its mass too. Derived by hand from the two-body Lagrangian in the rotating frame
+/// (kinetic ½I_h2 w² + ½μ[(ẋ + wd)² + w²x²], w = θ̇ − n; hub potential (3n²/2) r̂ᵀI_h r̂;
+/// tidal −½μ n²(3(r̂·p)² − |p|²) for p = (x, 0, d), r̂ = (sin θ, 0, −cos θ); spring ½kx²,
+/// dashpot c), with I_1, I_2, I_3 the composite moments (I_h + μd² about roll and pitch):
+///
+/// ```text
+/// I_2 θ̈ + μ d ẍ + 3n²(I_1 − I_3) θ + 3μn² d x = 0
+/// μ ẍ + μ d θ̈ + c ẋ + k x + 3μn² d θ = 0      (centrifugal and tidal μn²x cancel)
+/// ```
+///
+/// Roll–yaw does not move the mass along roll to first order, so it keeps the rigid closed
+/// form with the composite moments.
+#[test]
+fn a_pitch_damper_matches_the_hand_derived_equations() {
+    let (hub, m_hub, m, d, k, c) = ([9.5, 10.2, 0.8], 13.0, 0.1, 1.0, 3e-7, 5e-5);
+    let mu = m * m_hub / (m + m_hub);
+    let damper = format!(
+        "  - spring_mass_damper: {{name: d, mass: {m}, position: [0.0, 0.0, {d}], direction: \
+         [1, 0, 0], stiffness: {k:e}, damping: {c:e}}}\n"
+    );
+    let yaml = scene(
+        hub,
+        7000.0,
+        TURNED,
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0; 3],
+        1.0,
+        &damper,
+    )
+    .replace(
+        "body: {principal:",
+        &format!("body: {{mass: {m_hub}, principal:"),
+    );
+    let lin = linearize_yaml(&yaml).unwrap();
+    let n = lin.orbit_rate;
+    let composite = [hub[0] + mu * d * d, hub[1] + mu * d * d, hub[2]];
+    for (got, want) in lin.moments.iter().zip(composite) {
+        assert!((got - want).abs() < 1e-12 * want, "{lin:#?}");
+    }
+    assert!(lin.equilibrium_residual < 1e-12, "{lin:#?}");
+    // Roll–yaw: the rigid closed form of the composite moments.
+    let rigid: Vec<C64> = closed_form_eigenvalues(composite, n)
+        .into_iter()
+        .filter(|(_, role)| *role == "roll_yaw")
+        .map(|(z, _)| z)
+        .collect();
+    // Pitch and damper: M s² + C s + K, as a first-order 4×4 in (θ, x, θ̇, ẋ).
+    let (i1, i2, i3) = (composite[0], composite[1], composite[2]);
+    let mass = nalgebra::Matrix2::new(i2, mu * d, mu * d, mu);
+    let stiff = nalgebra::Matrix2::new(
+        3.0 * n * n * (i1 - i3),
+        3.0 * mu * n * n * d,
+        3.0 * mu * n * n * d,
+        k,
+    );
+    let damp = nalgebra::Matrix2::new(0.0, 0.0, 0.0, c);
+    let inv = mass.try_inverse().unwrap();
+    let mut a = nalgebra::Matrix4::<f64>::zeros();
+    a.fixed_view_mut::<2, 2>(0, 2)
+        .copy_from(&nalgebra::Matrix2::identity());
+    a.fixed_view_mut::<2, 2>(2, 0).copy_from(&(-inv * stiff));
+    a.fixed_view_mut::<2, 2>(2, 2).copy_from(&(-inv * damp));
+    let coupled: Vec<C64> = a.complex_eigenvalues().iter().copied().collect();
+    let mut unused: Vec<usize> = (0..lin.modes.len()).collect();
+    for (want, roles) in rigid
+        .iter()
+        .map(|z| (*z, &["roll_yaw"][..]))
+        .chain(coupled.iter().map(|z| (*z, &["pitch", "effector"][..])))
+    {
+        let (pos, err) = unused
+            .iter()
+            .enumerate()
+            .filter(|(_, k)| roles.contains(&lin.modes[**k].role.as_str()))
+            .map(|(p, &k)| {
+                (
+                    p,
+                    (C64::new(lin.modes[k].re, lin.modes[k].im) - want).norm(),
+                )
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap();
+        eprintln!(
+            "pitch damper: {roles:?} {want:.6e}: |Δλ|/n = {:.2e}",
+            err / n
+        );
+        assert!(err < 1e-8 * n, "{want}: off by {:.3e} n: {lin:#?}", err / n);
+        unused.remove(pos);
+    }
+    assert!(unused.is_empty());
+    // The damper drains the pitch libration: every pitch/damper mode decays.
+    assert!(coupled.iter().all(|z| z.re < -1e-6 * n), "{coupled:?}");
+    assert_eq!(lin.verdict, "marginally stable (oscillatory)");
+}
+
 /// What has no fixed LVLH equilibrium, or is not linearised here, is refused with the reason.
 #[test]
 fn refusals_name_the_reason() {
