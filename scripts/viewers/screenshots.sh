@@ -2,10 +2,12 @@
 # Opens an Explorer 1 log in the real viewers and checks what they show (docs/viewing.md):
 #   - Foxglove Studio (the last open-source release, in headless Chromium) with the shipped
 #     layout docs/viewers/polhode.foxglove-layout.json, at two times: the body is drawn and has
-#     turned, the plots are drawn;
+#     turned, the plots are drawn; then a scenario in orbit (gravity-gradient-smallsat): the
+#     orbit panel draws the Earth, the orbit path and the spacecraft marker, and they moved;
 #   - Rerun: `rerun mcap check` on a log of every shipped scenario, the MCAP converted to a
 #     native recording (`rerun rrd verify`, transforms and telemetry compared with the MCAP),
-#     and a headless screenshot with the body and the plots.
+#     and headless screenshots with the body and the plots, and (in orbit) the Earth, the orbit
+#     path and the marker.
 #
 #   scripts/viewers/screenshots.sh [OUT_DIR]     (default docs/figures/viewing)
 #

@@ -7,12 +7,13 @@
 //! (`polhode.effectors.HingedRodFlapLag`, [`units::effector_message`]); every field of the
 //! polhode schemas carries its unit as its protobuf comment ([`units::field_unit`]).
 //! A scenario with an orbit adds `/orbit` (`polhode.Orbit`: position, velocity, altitude and
-//! the attitude relative to LVLH) and an `lvlh` frame in `/tf`; a scenario without one writes
-//! neither.
+//! the attitude relative to LVLH), the `lvlh`, `eci` and `ecef` frames in `/tf`, and the orbit
+//! view ([`orbit_scene`]: `/earth`, `/orbit_scene`); a scenario without one writes none of it.
 //! Log time = scenario epoch + sim time. The file is written under a temporary name in the
 //! target directory and renamed when finished, so a final name never holds a half-written log.
 
 pub mod orbit;
+pub mod orbit_scene;
 pub mod telemetry;
 pub mod units;
 
@@ -66,6 +67,8 @@ pub struct McapLogger<'a> {
     orbit: Option<Arc<crate::orbit::Orbit>>,
     /// Name of the LVLH frame (`lvlh`, or `<prefix>/lvlh`).
     lvlh_frame: String,
+    /// The orbit view (`eci` and `ecef` in `/tf`, `/earth`, `/orbit_scene`), with an orbit.
+    orbit_scene: Option<orbit_scene::OrbitScene>,
     /// The polhode schemas and channels registered so far.
     registry: Registry,
     buf: Vec<u8>,
@@ -88,6 +91,9 @@ struct Channels {
     log: u16,
     /// `/orbit`, for a scenario with an orbit.
     orbit: Option<u16>,
+    /// `/earth` and `/orbit_scene`, for a scenario with an orbit.
+    earth: Option<u16>,
+    orbit_scene: Option<u16>,
 }
 
 /// A temporary file that is removed when dropped (on errors and panics alike) unless it was
@@ -162,6 +168,23 @@ fn frame_name(prefix: &str, frame: &str) -> String {
     }
 }
 
+/// The orbit view of `scenario` under `prefix`, if it has an orbit.
+fn orbit_view(scenario: &Scenario, prefix: &str) -> Option<orbit_scene::OrbitScene> {
+    let orbit = scenario.orbit.clone()?;
+    // `world` is shared by the runs of a file (only the body and LVLH frames take the prefix),
+    // and so are the Earth's frames.
+    let frames = orbit_scene::Frames {
+        eci: orbit_scene::ECI_FRAME.into(),
+        ecef: orbit_scene::ECEF_FRAME.into(),
+        world: WORLD_FRAME.into(),
+        body: body_frame(prefix),
+        lvlh: frame_name(prefix, LVLH_FRAME),
+    };
+    let epoch = scenario.epoch_unix_ns;
+    let earth_angle = Box::new(move |t| crate::orbit::earth_rotation_angle(epoch, t));
+    Some(orbit_scene::OrbitScene::new(orbit, earth_angle, frames))
+}
+
 /// Adds the schemas and channels of one run under `prefix`.
 fn register(
     writer: &mut mcap::Writer<BufWriter<File>>,
@@ -217,6 +240,16 @@ fn register(
         )?);
     }
     // Only for a scenario with an orbit: a scenario without one writes the same file as before.
+    let (earth, orbit_scene) = match &scenario.orbit {
+        Some(_) => (
+            Some(add::<fg::SceneUpdate>(writer, &format!("{prefix}/earth"))?),
+            Some(add::<fg::SceneUpdate>(
+                writer,
+                &format!("{prefix}/orbit_scene"),
+            )?),
+        ),
+        None => (None, None),
+    };
     let orbit = match &scenario.orbit {
         Some(_) => {
             let schema = orbit::schema_bytes();
@@ -244,6 +277,8 @@ fn register(
             telemetry,
             log,
             orbit,
+            earth,
+            orbit_scene,
         },
         effector_channels,
     ))
@@ -367,6 +402,7 @@ impl<'a> McapLogger<'a> {
             body_frame: body_frame(prefix),
             orbit: scenario.orbit.clone(),
             lvlh_frame: frame_name(prefix, LVLH_FRAME),
+            orbit_scene: orbit_view(scenario, prefix),
             registry,
             buf: Vec::with_capacity(1024),
         })
@@ -403,6 +439,7 @@ impl<'a> McapLogger<'a> {
             body_frame: body_frame(prefix),
             orbit: scenario.orbit.clone(),
             lvlh_frame: frame_name(prefix, LVLH_FRAME),
+            orbit_scene: orbit_view(scenario, prefix),
             registry,
             buf,
         })
@@ -621,6 +658,17 @@ impl<'a> McapLogger<'a> {
         }
         let scene = self.scene_update(&o, &y0);
         let per_scene = self.encoded_len(&scene) + PER_MESSAGE;
+        // The orbit view: `/earth` once, `/orbit_scene` at its own rate (the `eci` and `ecef`
+        // transforms are in `tf` above).
+        let mut orbit_view = 0.0;
+        if let Some(view) = self.orbit_scene.take() {
+            let ts = self.timestamp(0.0);
+            orbit_view = self.encoded_len(&view.earth(ts))
+                + PER_MESSAGE
+                + view.updates(scenario.duration, scenario.output_rate)
+                    * (self.encoded_len(&view.update(0.0, ts)) + PER_MESSAGE);
+            self.orbit_scene = Some(view);
+        }
         let samples = (scenario.duration * scenario.output_rate).floor() + 2.0;
         let scenes =
             (scenario.duration * scenario.scene_rate.min(scenario.output_rate)).floor() + 2.0;
@@ -628,12 +676,13 @@ impl<'a> McapLogger<'a> {
             64.0 * 1024.0 + 2.0 * self.registry.bytes as f64 + 2.0 * scenario.source.len() as f64;
         // Scene updates grow as appendages deflect: uncompressed logs of the shipped scenarios
         // measured 0.76–1.05 times the raw figure (docs/reliability.md); 10 % covers that.
-        1.1 * (samples * per_sample + scenes * per_scene) + fixed
+        1.1 * (samples * per_sample + scenes * per_scene + orbit_view) + fixed
     }
 
     /// The `/tf` message placing the body frame in `world` at the observation's attitude,
     /// followed, for a scenario with an orbit, by the LVLH frame in `world` (at the origin,
-    /// like the body, rotated by `q_NO`).
+    /// like the body, rotated by `q_NO`), then `world` in `eci` (at r(t)) and `ecef` in `eci`
+    /// (rotated by the Earth rotation angle).
     fn body_transform(&self, o: &Observation) -> fg::FrameTransforms {
         let transform = |child: &str, q: &UnitQuaternion<f64>| fg::FrameTransform {
             timestamp: Some(self.timestamp(o.t)),
@@ -655,7 +704,34 @@ impl<'a> McapLogger<'a> {
         if let Some(orbit) = &self.orbit {
             transforms.push(transform(&self.lvlh_frame, &orbit.lvlh(o.t).lvlh_to_eci()));
         }
+        if let Some(view) = &self.orbit_scene {
+            transforms.extend(view.transforms(o.t, self.timestamp(o.t)));
+        }
         fg::FrameTransforms { transforms }
+    }
+
+    /// For a scenario with an orbit: `/earth` at the first sample, `/orbit_scene` when due.
+    fn orbit_view(&mut self, t: f64) -> io::Result<()> {
+        let (Some(earth), Some(channel)) = (self.channels.earth, self.channels.orbit_scene) else {
+            return Ok(());
+        };
+        let Some(mut view) = self.orbit_scene.take() else {
+            return Ok(());
+        };
+        let first = view.is_first();
+        let due = view.due(t);
+        let timestamp = self.timestamp(t);
+        let result = (|| {
+            if first {
+                self.write(earth, t, &view.earth(timestamp))?;
+            }
+            if due {
+                self.write(channel, t, &view.update(t, timestamp))?;
+            }
+            Ok(())
+        })();
+        self.orbit_scene = Some(view);
+        result
     }
 
     fn encoded_len<T: Encode>(&mut self, msg: &T) -> f64 {
@@ -864,6 +940,7 @@ impl Sink for McapLogger<'_> {
             self.write(self.channels.scene, o.t, &scene)?;
             self.scene.last = Some(o.t);
         }
+        self.orbit_view(o.t)?;
         let values = telemetry::values(o, inv);
         telemetry::encode_doubles(&values, &mut self.buf);
         self.write_raw(self.channels.telemetry, self.log_time(o.t))?;

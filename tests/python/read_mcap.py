@@ -50,7 +50,20 @@ What it checks:
     - exactly one transform, parent_frame_id "world", child_frame_id "body",
       | |q| - 1 | <= 1e-9, and timestamp (seconds, nanos) == the log time;
       in a log with an /orbit channel, a second transform "world" -> "lvlh",
-      likewise a unit quaternion stamped at the log time.
+      likewise a unit quaternion stamped at the log time, then "eci" -> "world"
+      (no rotation; translation = the /orbit position r_eci x 1000 m within
+      1e-9 relative) and "eci" -> "ecef" (zero translation, a unit rotation
+      about z only).
+  /earth and /orbit_scene (foxglove.SceneUpdate), only with an /orbit channel
+    - /earth: one message, at the first /tf log time, entity "earth" in frame
+      "ecef", frame-locked, with a sphere of diameter 2 x 6378137 m at the
+      origin;
+    - /orbit_scene: entity "orbit_path" in "eci" whose first point is the
+      "eci" -> "world" translation at the same log time (1e-9 relative) and
+      whose points all lie between the perigee and apogee radii computed from
+      the /orbit position and velocity at that time (vis-viva, mu of WGS-84;
+      1e-9 relative), and entity "spacecraft_marker" in "world" with a sphere
+      at the origin (so the marker is at r(t)).
   /orbit (polhode.Orbit), only in the log of a scenario with an orbit
     - the fields listed in ORBIT_FIELDS exist, all finite, one message per
       /telemetry sample at the same log times;
@@ -123,6 +136,9 @@ ORBIT_FIELDS = (
     "roll_deg", "pitch_deg", "yaw_deg",
 )
 ORBIT_Q_TOL = 1e-9
+ORBIT_POS_TOL = 1e-9  # relative, orbit-view positions against /orbit
+MU_EARTH = 3.986004418e14  # m^3/s^2, WGS-84 GM
+R_EARTH = 6378137.0  # m, WGS-84 semi-major axis
 METADATA_NAME = "polhode"
 METADATA_KEYS = ("version", "scenario", "integrator", "epoch", "quaternion_convention", "status")
 ATTACHMENT_NAME = "scenario.yaml"
@@ -299,6 +315,10 @@ class McapCheck:
         # log_time -> (w, x, y, z) of the /tf lvlh rotation, and the /orbit samples
         self.lvlh_by_time: dict[int, tuple[float, float, float, float]] = {}
         self.orbit: list[tuple[int, dict[str, float]]] = []
+        # log_time -> eci -> world translation (m); the orbit-view scene messages
+        self.eci_world_by_time: dict[int, tuple[float, float, float]] = {}
+        self.earth_messages: list[tuple[int, Any]] = []
+        self.orbit_scenes: list[tuple[int, Any]] = []
 
     # ------------------------------------------------------------------ driver
     def run(self) -> None:
@@ -332,6 +352,7 @@ class McapCheck:
         self._check_counts()
         self._check_tf_telemetry()
         self._check_orbit()
+        self._check_orbit_view()
         self._check_scene()
         if self.spin_z is not None:
             self._check_spin_z(self.spin_z)
@@ -598,6 +619,10 @@ class McapCheck:
             self._on_log(log_time, msg)
         elif topic == "/orbit":
             self._on_orbit(log_time, msg)
+        elif topic == "/earth":
+            self.earth_messages.append((log_time, msg))
+        elif topic == "/orbit_scene":
+            self.orbit_scenes.append((log_time, msg))
         elif topic.startswith("/effectors/"):
             self._on_effector(topic, log_time, msg)
 
@@ -616,7 +641,7 @@ class McapCheck:
         where = f"/tf {_fmt_t(log_time)}"
         self.tf_times.append(log_time)
         transforms = list(msg.transforms)
-        expected = 2 if self.has_orbit else 1
+        expected = 4 if self.has_orbit else 1
         if len(transforms) != expected:
             self.checks.fail("tf", f"{where}: {len(transforms)} transforms, expected {expected}")
             if not transforms:
@@ -637,6 +662,29 @@ class McapCheck:
             if not math.isfinite(norm) or abs(norm - 1.0) > UNIT_QUAT_TOL:
                 self.checks.fail("tf unit", f"{where}: lvlh |q| = {norm!r}")
             self.lvlh_by_time[log_time] = q
+        if self.has_orbit and len(transforms) >= 4:
+            world, ecef = transforms[2], transforms[3]
+            if (world.parent_frame_id, world.child_frame_id) != ("eci", "world") or (
+                ecef.parent_frame_id,
+                ecef.child_frame_id,
+            ) != ("eci", "ecef"):
+                self.checks.fail(
+                    "tf frames",
+                    f"{where}: transforms 3 and 4 are {world.parent_frame_id!r} -> "
+                    f"{world.child_frame_id!r} and {ecef.parent_frame_id!r} -> "
+                    f"{ecef.child_frame_id!r}, expected 'eci' -> 'world' and 'eci' -> 'ecef'",
+                )
+            r = world.rotation
+            if (r.x, r.y, r.z, r.w) != (0.0, 0.0, 0.0, 1.0):
+                self.checks.fail("tf eci", f"{where}: eci -> world is rotated")
+            e = ecef.rotation
+            t = ecef.translation
+            if e.x != 0.0 or e.y != 0.0 or abs(e.z * e.z + e.w * e.w - 1.0) > UNIT_QUAT_TOL:
+                self.checks.fail("tf ecef", f"{where}: eci -> ecef is not a unit rotation about z")
+            if (t.x, t.y, t.z) != (0.0, 0.0, 0.0):
+                self.checks.fail("tf ecef", f"{where}: eci -> ecef is translated")
+            p = world.translation
+            self.eci_world_by_time[log_time] = (p.x, p.y, p.z)
         tf = transforms[0]
         if tf.parent_frame_id != "world" or tf.child_frame_id != "body":
             self.checks.fail(
@@ -766,6 +814,84 @@ class McapCheck:
                 self.checks.fail(
                     "orbit quaternion",
                     f"{where}: q_NO x q_OB differs from the /tf body rotation (1 - |dot| = {1.0 - dot:.1e})",
+                )
+
+    def _check_orbit_view(self) -> None:
+        if not self.has_orbit:
+            return
+        first_tf = self.tf_times[0] if self.tf_times else None
+        if len(self.earth_messages) != 1 or self.earth_messages[0][0] != first_tf:
+            self.checks.fail(
+                "earth", f"/earth: {len(self.earth_messages)} messages, expected one at the first /tf"
+            )
+        for _, msg in self.earth_messages[:1]:
+            earth = [e for e in msg.entities if e.id == "earth"]
+            ok = (
+                len(earth) == 1
+                and earth[0].frame_id == "ecef"
+                and earth[0].frame_locked
+                and any(
+                    s.size.x == s.size.y == s.size.z == 2.0 * R_EARTH
+                    and (s.pose.position.x, s.pose.position.y, s.pose.position.z) == (0.0, 0.0, 0.0)
+                    for s in earth[0].spheres
+                )
+            )
+            if not ok:
+                self.checks.fail("earth", "/earth: no frame-locked 'earth' sphere of the Earth's size in 'ecef'")
+        orbit_by_time = dict(self.orbit)
+        if not self.orbit_scenes:
+            self.checks.fail("orbit scene", "/orbit_scene: no message")
+        for log_time, msg in self.orbit_scenes:
+            where = f"/orbit_scene {_fmt_t(log_time)}"
+            by_id = {e.id: e for e in msg.entities}
+            path, marker = by_id.get("orbit_path"), by_id.get("spacecraft_marker")
+            r_tf = self.eci_world_by_time.get(log_time)
+            v = orbit_by_time.get(log_time)
+            if path is None or path.frame_id != "eci" or not path.lines or r_tf is None or v is None:
+                self.checks.fail("orbit scene", f"{where}: no orbit_path in 'eci', or no /tf and /orbit then")
+                continue
+            if (
+                marker is None
+                or marker.frame_id != "world"
+                or not marker.frame_locked
+                or not any(
+                    (s.pose.position.x, s.pose.position.y, s.pose.position.z) == (0.0, 0.0, 0.0)
+                    for s in marker.spheres
+                )
+            ):
+                self.checks.fail("orbit scene", f"{where}: no marker sphere at the origin of 'world'")
+            points = [(p.x, p.y, p.z) for p in path.lines[0].points]
+            r_norm = math.sqrt(sum(c * c for c in r_tf))
+            d0 = math.sqrt(sum((a - b) ** 2 for a, b in zip(points[0], r_tf)))
+            if d0 > ORBIT_POS_TOL * r_norm:
+                self.checks.fail("orbit scene", f"{where}: the path starts {d0:.3e} m from r(t)")
+            # r(t) and v(t) from /orbit (km, km/s) -> a and e (vis-viva, eccentricity vector).
+            r = [v[f"r_eci_{c}"] * 1e3 for c in "xyz"]
+            vel = [v[f"v_eci_{c}"] * 1e3 for c in "xyz"]
+            rn = math.sqrt(sum(c * c for c in r))
+            if abs(rn - r_norm) > ORBIT_POS_TOL * rn:
+                self.checks.fail("orbit tf", f"{where}: |eci -> world| {r_norm} m, /orbit |r| {rn} m")
+            v2 = sum(c * c for c in vel)
+            a = 1.0 / (2.0 / rn - v2 / MU_EARTH)
+            rv = sum(x * y for x, y in zip(r, vel))
+            e_vec = [((v2 - MU_EARTH / rn) * ri - rv * vi) / MU_EARTH for ri, vi in zip(r, vel)]
+            e = math.sqrt(sum(c * c for c in e_vec))
+            r_min, r_max = a * (1.0 - e), a * (1.0 + e)
+            for p in points:
+                n = math.sqrt(sum(c * c for c in p))
+                if not (r_min * (1 - ORBIT_POS_TOL) <= n <= r_max * (1 + ORBIT_POS_TOL)):
+                    self.checks.fail(
+                        "orbit scene",
+                        f"{where}: path point at {n} m outside [{r_min}, {r_max}] m",
+                    )
+                    break
+        for log_time, v in self.orbit:
+            r_tf = self.eci_world_by_time.get(log_time)
+            r = [v[f"r_eci_{c}"] * 1e3 for c in "xyz"]
+            rn = math.sqrt(sum(c * c for c in r))
+            if r_tf is None or math.sqrt(sum((a - b) ** 2 for a, b in zip(r, r_tf))) > ORBIT_POS_TOL * rn:
+                self.checks.fail(
+                    "orbit tf", f"/orbit {_fmt_t(log_time)}: eci -> world translation != r_eci x 1000"
                 )
 
     def _check_tf_telemetry(self) -> None:

@@ -2,16 +2,22 @@
 # Opens a polhode log in Foxglove Studio (open-source studio-base 1.48, headless Chromium) with
 # the shipped layout docs/viewers/polhode.foxglove-layout.json, saves two screenshots and checks
 # them. Installs what is missing (Debian's chromium, the npm packages of this folder), makes
-# the explorer1-pydy log, and writes $OUT/foxglove-early.png and $OUT/foxglove-late.png.
+# the explorer1-pydy log, and writes $OUT/foxglove-early.png and $OUT/foxglove-late.png; then
+# the same with a scenario in orbit (the orbit panel: Earth, path, marker), written to
+# $OUT/foxglove-orbit-early.png and $OUT/foxglove-orbit-late.png.
 #
 #   scripts/viewers/foxglove/run.sh
 #
 # Environment: POLHODE (the polhode binary; default target/release/polhode, built with cargo
 # if missing), OUT (default docs/figures/viewing), SCENARIO (default
 # scenarios/explorer1-pydy.yaml), EARLY and LATE (seconds into the log; default 10 and 120),
-# CHROMIUM (default /usr/bin/chromium). The checks want every plotted series visible: true of
-# explorer1-pydy, not of a rigid body, whose dissipated and elastic energies are both 0 and
-# hide each other.
+# CHROMIUM (default /usr/bin/chromium), ORBIT_SCENARIO (default
+# scenarios/gravity-gradient-smallsat.yaml, run for ORBIT_DURATION s, default 3600),
+# ORBIT_EARLY and ORBIT_LATE (default 2000 and 3400 s: a quarter of an orbit apart, both on the
+# side of the Earth the orbit panel's camera looks at). The checks want every
+# plotted series visible: true of explorer1-pydy, not of a rigid body, whose dissipated and
+# elastic energies are both 0 and hide each other (so the orbit capture only wants the plots
+# not blank).
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -67,15 +73,27 @@ if ! "$polhode" run "$scenario" --out "$log" >"$work/polhode.txt" 2>&1; then
   exit 1
 fi
 echo "log: $(basename "$log"), $(du -h "$log" | cut -f1), $(since "$t_log") s"
+orbit_scenario="${ORBIT_SCENARIO:-$repo/scenarios/gravity-gradient-smallsat.yaml}"
+orbit_log="$work/$(basename "$orbit_scenario" .yaml).mcap"
+if ! "$polhode" run "$orbit_scenario" --out "$orbit_log" --duration "${ORBIT_DURATION:-3600}" \
+  >"$work/polhode-orbit.txt" 2>&1; then
+  cat "$work/polhode-orbit.txt" >&2
+  echo "FAIL: polhode could not make the orbit log" >&2
+  exit 1
+fi
+echo "log: $(basename "$orbit_log"), $(du -h "$orbit_log" | cut -f1)"
 
 # 4. Screenshots and checks.
 t_shots=$(now)
 status=0
 node "$here/screenshots.mjs" --log "$log" --out "$out" --chromium "$chromium" \
   --early "${EARLY:-10}" --late "${LATE:-120}" || status=$?
+node "$here/screenshots.mjs" --log "$orbit_log" --out "$out" --chromium "$chromium" --orbit \
+  --early "${ORBIT_EARLY:-2000}" --late "${ORBIT_LATE:-3400}" || status=$?
 echo "screenshots: $(since "$t_shots") s"
 if [ "$status" -eq 0 ]; then
-  echo "PASS (foxglove): $out/foxglove-early.png, $out/foxglove-late.png"
+  echo "PASS (foxglove): $out/foxglove-early.png, $out/foxglove-late.png," \
+    "$out/foxglove-orbit-early.png, $out/foxglove-orbit-late.png"
 else
   echo "FAIL (foxglove)"
 fi

@@ -1,14 +1,18 @@
 // Opens a polhode MCAP log in Foxglove Studio (studio-base 1.48, headless Chromium) with the
 // shipped layout docs/viewers/polhode.foxglove-layout.json at two times, saves a screenshot of
-// each and checks them: neither is blank, the 3D panel changed between the two (the body
-// turned), and every plotted series is drawn. Exits 1 with a message when a check fails.
+// each and checks them: neither is blank, the body's 3D panel changed between the two (the
+// body turned), and every plotted series is drawn. With --orbit (a log of a scenario with an
+// orbit), the orbit panel is checked instead of the series: the Earth, the orbit path and the
+// spacecraft marker are drawn and the panel changed between the two times (the spacecraft
+// moved, the Earth turned); the plots need only not be blank (a rigid body's energies are 0
+// and hide each other). Exits 1 with a message when a check fails.
 //
-//   node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S]
-//                        [--chromium PATH] [--timeout S]
+//   node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S] [--orbit]
+//                        [--name NAME] [--chromium PATH] [--timeout S]
 //
 // --early and --late are seconds after the log's first message (default 10 and 120).
-// Screenshots: DIR/foxglove-early.png and DIR/foxglove-late.png (DIR defaults to
-// docs/figures/viewing in the repository).
+// Screenshots: DIR/NAME-early.png and DIR/NAME-late.png (NAME defaults to foxglove, or
+// foxglove-orbit with --orbit; DIR to docs/figures/viewing in the repository).
 
 import { open, readFile, mkdir, writeFile } from "node:fs/promises";
 import { basename, dirname, join, resolve } from "node:path";
@@ -30,6 +34,13 @@ const MIN_SERIES_PIXELS = 250; // pixels of a series' colour in its plot (a lege
 const COLOUR_TOLERANCE = 40; // largest channel difference that still counts as a series colour
 const PIXEL_DIFFERENCE = 30; // summed |dR|+|dG|+|dB| that makes two pixels differ
 const MIN_BODY_PIXELS = 1000; // light grey pixels (the body) in the 3D panel; none without /scene
+const MIN_BODY_PIXELS_ORBIT = 500; // with --orbit: the gravity-gradient smallsat is a slim box
+// The orbit panel (--orbit): blue-dominant pixels of the Earth's sphere, pixels of the orbit
+// path's cyan and of the marker's magenta (none without /earth or /orbit_scene).
+const MIN_EARTH_PIXELS = 5000;
+const PATH_COLOUR = [77, 242, 242]; // rgb of (0.3, 0.95, 0.95) in src/log/orbit_scene.rs
+const MIN_PATH_PIXELS = 150;
+const MIN_MARKER_PIXELS = 20;
 
 const CHROMIUM_FLAGS = [
   "--no-sandbox",
@@ -147,17 +158,19 @@ window.regionStats = async (b64, rect, colours, tol, pixDiff) => {
     }
   }
   bg = bg.map((v) => v / m);
-  let fg = 0, grey = 0;
+  let fg = 0, grey = 0, blue = 0, magenta = 0;
   const hits = colours.map(() => 0);
   for (const i of inside(im, rect)) {
     const hi = Math.max(d[i], d[i + 1], d[i + 2]), lo = Math.min(d[i], d[i + 1], d[i + 2]);
     if (hi >= 110 && hi - lo <= 25) grey++;
+    if (d[i + 2] >= 70 && d[i + 2] - d[i] >= 40 && d[i + 2] - d[i + 1] >= 15) blue++;
+    if (d[i] >= 150 && d[i + 2] >= 110 && d[i] - d[i + 1] >= 90 && d[i + 2] - d[i + 1] >= 60) magenta++;
     if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > pixDiff) fg++;
     colours.forEach((c, k) => {
       if (Math.abs(d[i] - c[0]) <= tol && Math.abs(d[i + 1] - c[1]) <= tol && Math.abs(d[i + 2] - c[2]) <= tol) hits[k]++;
     });
   }
-  return { pixels: n, distinct: counts.size, foreground: fg, foregroundFraction: fg / Math.max(n, 1), colourPixels: hits, grey,
+  return { pixels: n, distinct: counts.size, foreground: fg, foregroundFraction: fg / Math.max(n, 1), colourPixels: hits, grey, blue, magenta,
            background: bg.map(Math.round) };
 };
 window.regionDiff = async (a, b, rect, pixDiff) => {
@@ -279,8 +292,11 @@ async function main() {
       late: { type: "string", default: "120" },
       chromium: { type: "string", default: process.env.CHROMIUM ?? "/usr/bin/chromium" },
       timeout: { type: "string", default: "120" },
+      orbit: { type: "boolean", default: false },
+      name: { type: "string" },
     },
   });
+  const name = args.name ?? (args.orbit ? "foxglove-orbit" : "foxglove");
   if (!args.log) {
     fail("usage: node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S]");
   }
@@ -308,10 +324,12 @@ async function main() {
       fail(`${LAYOUT_FILE}: panel ${p.id} needs a foxglovePanelTitle and a #rrggbb colour on every path`);
     }
   }
-  const threeD = panels.find((p) => p.kind === "3D");
+  // The body's 3D panel and the orbit's (by id).
+  const threeD = panels.find((p) => p.kind === "3D" && !p.id.includes("orbit"));
+  const orbitPanel = panels.find((p) => p.kind === "3D" && p.id.includes("orbit"));
   const plots = panels.filter((p) => p.kind === "Plot");
-  if (!threeD || plots.length === 0) {
-    fail(`${LAYOUT_FILE}: expected a 3D panel and plot panels`);
+  if (!threeD || !orbitPanel || plots.length === 0) {
+    fail(`${LAYOUT_FILE}: expected a body 3D panel, an orbit 3D panel and plot panels`);
   }
 
   // The repository (page, bundle, shipped layout) and the log's folder, on loopback only.
@@ -336,22 +354,22 @@ async function main() {
   await mkdir(args.out, { recursive: true });
   const shots = {};
   try {
-    for (const [name, t] of Object.entries(times)) {
+    for (const [when, t] of Object.entries(times)) {
       const at = start + BigInt(Math.round(t * 1e9));
       const query = new URLSearchParams({ ds: "remote-file", "ds.url": logUrl, layoutId: LAYOUT_ID, time: rfc3339(at) });
       const pageUrl = `http://127.0.0.1:${sitePort}/scripts/viewers/foxglove/index.html?${query}`;
       const t0 = Date.now();
       const shot = await capture(browser, pageUrl, panels, timeoutMs, analysis);
-      const file = join(args.out, `foxglove-${name}.png`);
+      const file = join(args.out, `${name}-${when}.png`);
       await writeFile(file, Buffer.from(shot.png, "base64"));
       console.log(
-        `${name}: t = ${t} s (${rfc3339(at)}), shown ${shot.shownTime ?? "?"}, ${((Date.now() - t0) / 1000).toFixed(1)} s` +
+        `${when}: t = ${t} s (${rfc3339(at)}), shown ${shot.shownTime ?? "?"}, ${((Date.now() - t0) / 1000).toFixed(1)} s` +
           ` (settled after ${shot.settleSeconds.toFixed(1)} s) -> ${file}`,
       );
       for (const e of shot.errors) {
         console.log(`  page error: ${e.slice(0, 300)}`);
       }
-      shots[name] = shot;
+      shots[when] = shot;
     }
 
     // The checks.
@@ -375,22 +393,42 @@ async function main() {
       );
       if (!ok3) problems.push(`${name}: the 3D panel is blank`);
       // (a) The body itself (light grey, from /scene) is drawn, not only the grid and axes.
-      const okBody = s3.grey >= MIN_BODY_PIXELS;
-      console.log(`  [${okBody ? "ok" : "FAIL"}] ${name} body drawn: ${s3.grey} light grey pixels (>= ${MIN_BODY_PIXELS})`);
+      const minBody = args.orbit ? MIN_BODY_PIXELS_ORBIT : MIN_BODY_PIXELS;
+      const okBody = s3.grey >= minBody;
+      console.log(`  [${okBody ? "ok" : "FAIL"}] ${name} body drawn: ${s3.grey} light grey pixels (>= ${minBody})`);
       if (!okBody) problems.push(`${name}: no body in the 3D panel (is /scene drawn?)`);
-      // (a, c) Each plot is drawn, with every series present.
+      // (d) With --orbit: the Earth, the orbit path and the spacecraft marker are drawn.
+      if (args.orbit) {
+        const so = await stats(shot, orbitPanel.title, [PATH_COLOUR]);
+        const okBlank = so.distinct >= MIN_DISTINCT_COLOURS && so.foregroundFraction >= MIN_FOREGROUND_FRACTION;
+        const okEarth = so.blue >= MIN_EARTH_PIXELS;
+        const okPath = so.colourPixels[0] >= MIN_PATH_PIXELS;
+        const okMarker = so.magenta >= MIN_MARKER_PIXELS;
+        console.log(
+          `  [${okBlank && okEarth && okPath && okMarker ? "ok" : "FAIL"}] ${name} orbit panel: ${so.distinct} colours,` +
+            ` ${(100 * so.foregroundFraction).toFixed(2)} % off the background; Earth ${so.blue} blue pixels` +
+            ` (>= ${MIN_EARTH_PIXELS}), path ${so.colourPixels[0]} cyan (>= ${MIN_PATH_PIXELS}),` +
+            ` marker ${so.magenta} magenta (>= ${MIN_MARKER_PIXELS})`,
+        );
+        if (!okBlank) problems.push(`${name}: the orbit panel is blank`);
+        if (!okEarth) problems.push(`${name}: no Earth in the orbit panel (is /earth drawn?)`);
+        if (!okPath) problems.push(`${name}: no orbit path in the orbit panel (is /orbit_scene drawn?)`);
+        if (!okMarker) problems.push(`${name}: no spacecraft marker in the orbit panel`);
+      }
+      // (a, c) Each plot is drawn, with every series present (with --orbit: not blank).
       for (const p of plots) {
         const sp = await stats(shot, p.title, p.series.map((s) => s.colour));
         const okBlank = sp.distinct >= MIN_DISTINCT_COLOURS && sp.foregroundFraction >= MIN_FOREGROUND_FRACTION;
         const perSeries = p.series.map((s, k) => `${s.path.replace("/telemetry.", "")} ${sp.colourPixels[k]}`).join(", ");
         const okSeries = sp.colourPixels.every((n) => n >= MIN_SERIES_PIXELS);
+        const mark = okBlank && okSeries ? "ok" : !okBlank ? "FAIL" : args.orbit ? "info" : "FAIL";
         console.log(
-          `  [${okBlank && okSeries ? "ok" : "FAIL"}] ${name} plot "${p.title}": ${sp.distinct} colours,` +
+          `  [${mark}] ${name} plot "${p.title}": ${sp.distinct} colours,` +
             ` ${(100 * sp.foregroundFraction).toFixed(2)} % off the background; series pixels: ${perSeries}` +
             ` (each >= ${MIN_SERIES_PIXELS})`,
         );
         if (!okBlank) problems.push(`${name}: plot "${p.title}" is blank`);
-        if (!okSeries) problems.push(`${name}: plot "${p.title}" misses a series (${perSeries})`);
+        if (!okSeries && !args.orbit) problems.push(`${name}: plot "${p.title}" misses a series (${perSeries})`);
       }
     }
     // (b) The body moved: the 3D panel differs between the two times.
@@ -403,15 +441,34 @@ async function main() {
     ]);
     const okMoved = d.fraction >= MIN_3D_CHANGE_FRACTION;
     console.log(
-      `  [${okMoved ? "ok" : "FAIL"}] 3D panel differs between early and late: ${d.changed}/${d.pixels} = ` +
+      `  [${okMoved ? "ok" : args.orbit ? "info" : "FAIL"}] 3D panel differs between early and late: ${d.changed}/${d.pixels} = ` +
         `${(100 * d.fraction).toFixed(2)} % of pixels (>= ${100 * MIN_3D_CHANGE_FRACTION} %)`,
     );
-    if (!okMoved) problems.push("the 3D panel is the same at both times (the body did not move)");
+    // (In orbit the body turns once per orbit about the orbit normal: a short run may not move
+    // it enough; the orbit panel's change is checked instead.)
+    if (!okMoved && !args.orbit) problems.push("the 3D panel is the same at both times (the body did not move)");
+    if (args.orbit) {
+      const ro = shots.early.regions[orbitPanel.title];
+      const dO = await analysis.evaluate(([a, b, rr, pd]) => window.regionDiff(a, b, rr, pd), [
+        shots.early.png,
+        shots.late.png,
+        ro,
+        PIXEL_DIFFERENCE,
+      ]);
+      const okOrbitMoved = dO.fraction >= MIN_3D_CHANGE_FRACTION;
+      console.log(
+        `  [${okOrbitMoved ? "ok" : "FAIL"}] orbit panel differs between early and late: ${dO.changed}/${dO.pixels} = ` +
+          `${(100 * dO.fraction).toFixed(2)} % of pixels (>= ${100 * MIN_3D_CHANGE_FRACTION} %)`,
+      );
+      if (!okOrbitMoved) problems.push("the orbit panel is the same at both times (the spacecraft did not move)");
+    }
 
     if (problems.length > 0) {
       fail(problems.join("; "));
     }
-    console.log("PASS: Foxglove opened the log with the shipped layout; 3D panel and plots drawn at both times");
+    console.log(
+      `PASS: Foxglove opened the log with the shipped layout; 3D panel${args.orbit ? "s (body and orbit)" : ""} and plots drawn at both times`,
+    );
   } finally {
     await browser.close();
     site.close();

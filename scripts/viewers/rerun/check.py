@@ -16,7 +16,11 @@ it. Against it, this compares what Rerun itself reads (its own chunk readers, `r
 - with --fields, that the telemetry schema lists `FIELDS` of telemetry.rs, in order;
 - with --png, a screenshot of the converted recording with its blueprint (window 1600x1000):
   not blank, the body in the 3D view (solid blocks of its grey), and a line across each of the
-  four plots (their series colours over most of the width).
+  four plots (their series colours over most of the width); with --orbit as well, the orbit
+  view under the body's: the Earth (solid blue blocks), the orbit path (its cyan) and the
+  spacecraft marker (magenta);
+- for a log with the orbit view, the Earth's sphere at the one `/earth` update and the orbit
+  path and marker at every `/orbit_scene` update.
 
 Prints one line per check and exits 1 if any failed.
 """
@@ -219,6 +223,16 @@ def check_rrd(rrd: Path, ref: dict) -> None:
                 report(False, f"{topic}: sim_time timeline")
 
     for topic, n_scene in ref["scene"].items():
+        if topic.endswith(("/earth", "/orbit_scene")):
+            # The orbit view (docs/logs.md): the Earth's sphere once; per update the orbit path
+            # and the spacecraft marker.
+            want = {"/earth": ["/earth/spheres"], "/orbit_scene": ["/orbit_path/lines", "/spacecraft_marker/spheres"]}
+            for leaf in want[topic[topic.rfind("/"):]]:
+                p = next((p for p in ents if p.endswith(leaf)), None)
+                col = next((c for c in ents[p][0].schema.names if c.endswith((":centers", ":strips"))), None) if p else None
+                n = len(column(ents.get(p, []), col)[0]) if col else 0
+                report(n == n_scene, f"{topic}: {leaf.strip('/')} at {p} in {n} of {n_scene} updates")
+            continue
         bodies = [p for p in ents if p.endswith(("/cubes", "/cylinders"))]
         rows = {p: len(column(ents[p], next(c for c in ents[p][0].schema.names if c.endswith((":centers"))))[0]) for p in bodies}
         report(bool(bodies) and all(n == n_scene for n in rows.values()), f"{topic}: body drawn at {sorted(rows.items())} of {n_scene} updates")
@@ -244,11 +258,17 @@ PLOTS = [
     ("ω", (0.06, 0.26), (62, 142, 232)),  # ω_z
     ("nutation", (0.29, 0.49), (165, 110, 255)),
     ("T", (0.52, 0.73), (245, 158, 11)),
-    ("dissipated", (0.755, 0.965), (229, 72, 77)),
+    ("dissipated", (0.755, 0.965), (229, 72, 77)),  # roll, in the same red, with an orbit
 ]
 
+# With an orbit (--orbit): the body's view and the orbit view share the left column.
+BODY_VIEW = (0.08, 0.72)
+BODY_VIEW_ORBIT = (0.06, 0.40)
+ORBIT_VIEW = (0.44, 0.80)
+PATH_RGB = (77, 242, 242)  # the orbit path, (0.3, 0.95, 0.95) in src/log/orbit_scene.rs
 
-def check_png(png: Path) -> dict:
+
+def check_png(png: Path, orbit: bool = False) -> dict:
     from PIL import Image
 
     print(f"screenshot: {png}")
@@ -265,7 +285,7 @@ def check_png(png: Path) -> dict:
 
     # Solid blocks of the body's light grey and of the H arrow's blue: text and thin lines
     # (tables, labels, grid) fill no whole block.
-    view = region(0.08, 0.72, 0.01, 0.54)
+    view = region(*(BODY_VIEW_ORBIT if orbit else BODY_VIEW), 0.01, 0.54)
     k = max(2, w // 400)  # block side: 8 px in a 3200 px wide image
 
     def blocks(mask):
@@ -276,12 +296,25 @@ def check_png(png: Path) -> dict:
     lo, hi = view.min(axis=2), view.max(axis=2)
     body = blocks((lo > 140) & (hi - lo < 45))
     stats.update(body_blocks=body)
-    report(body >= 30, f"3D view: body, {body} solid light-grey {k}x{k} blocks (>= 30)")
+    # In orbit the body's view is shorter and the gravity-gradient smallsat a slim box.
+    min_body = 15 if orbit else 30
+    report(body >= min_body, f"3D view: body, {body} solid light-grey {k}x{k} blocks (>= {min_body})")
     # Arrows can be thin or short (omega in a flat spin): counted, not required.
     blue = np.mean((b > 170) & (b - r > 90) & (g > 70) & (g < 200))
     orange = np.mean((r > 190) & (g > 90) & (g < 190) & (b < 90))
     stats.update(blue_pct=round(100 * blue, 3), orange_pct=round(100 * orange, 3))
     print(f"  info 3D view: H-arrow blue on {100 * blue:.3f}%, omega-arrow orange on {100 * orange:.3f}% of it")
+
+    if orbit:
+        ov = region(*ORBIT_VIEW, 0.01, 0.54)
+        r, g, b = ov[..., 0], ov[..., 1], ov[..., 2]
+        earth = blocks((b >= 70) & (b - r >= 40) & (b - g >= 15))
+        path = int((np.abs(ov - np.array(PATH_RGB)).max(axis=2) <= 40).sum())
+        marker = int(((r >= 150) & (b >= 110) & (r - g >= 90) & (b - g >= 60)).sum())
+        stats.update(earth_blocks=earth, path_pixels=path, marker_pixels=marker)
+        report(earth >= 100, f"orbit view: Earth, {earth} solid blue {k}x{k} blocks (>= 100)")
+        report(path >= 200, f"orbit view: orbit path, {path} pixels of its cyan (>= 200)")
+        report(marker >= 20, f"orbit view: spacecraft marker, {marker} magenta pixels (>= 20)")
 
     for name, (y0, y1), rgb in PLOTS:
         plot = region(y0, y1, 0.57, 0.995)
@@ -303,6 +336,7 @@ def main() -> int:
     ap.add_argument("--png", type=Path, help="screenshot to check")
     ap.add_argument("--fields", type=Path, help="src/log/telemetry.rs, to check FIELDS")
     ap.add_argument("--no-raw", action="store_true", help="skip the raw MCAP through Rerun")
+    ap.add_argument("--orbit", action="store_true", help="the screenshot has the orbit view (--png)")
     args = ap.parse_args()
     ref = reference(args.mcap)
     if args.fields:
@@ -312,7 +346,7 @@ def main() -> int:
     if args.rrd:
         check_rrd(args.rrd, ref)
     if args.png:
-        check_png(args.png)
+        check_png(args.png, args.orbit)
     print(f"check: {'FAIL (' + str(len(failures)) + ')' if failures else 'PASS'} {args.mcap.name}")
     return 1 if failures else 0
 

@@ -15,7 +15,10 @@ file with the `mcap` reader and the protobuf schemas embedded in it, and writes:
   Scalars series at `<topic>/<field>`;
 - `/log` (`foxglove.Log`) as TextLog; the metadata and text attachments as TextDocuments;
 - a blueprint: the 3D view, plots of omega, nutation, T and |H|, energies, and tabs for the log,
-  drifts, angles, each effector and the scenario.
+  drifts, angles, each effector and the scenario. For a log with the orbit view (`/earth` and
+  `/orbit_scene`, a scenario with an orbit), a second 3D view in the Earth-centred frame `eci`
+  (the Earth to scale, the orbit path, the spacecraft marker and axes), and a plot of the
+  attitude relative to LVLH (roll, pitch, yaw) in place of the energies, which go to a tab.
 
 Timelines: `sim_time` (a duration: log time minus the run's epoch) and `message_log_time` (the
 MCAP log time, as Rerun names it when it opens an MCAP itself). Topics under a prefix (the
@@ -59,6 +62,16 @@ SERIES_STYLE = {
     "dissipated_energy": ("dissipated (J)", "#e5484d"),
     "elastic_energy": ("elastic (J)", "#12a594"),
 }
+
+# The attitude relative to LVLH (`/orbit`), coloured as omega's components.
+ORBIT_STYLE = {
+    "roll_deg": ("roll", "#e5484d"),
+    "pitch_deg": ("pitch", "#30a46c"),
+    "yaw_deg": ("yaw", "#3e8ee8"),
+}
+
+# Scene topics of the orbit view (docs/logs.md): drawn in the orbit view, not the body's.
+ORBIT_SCENE_LEAVES = ("earth", "orbit_scene")
 
 NUMERIC = {
     FieldDescriptor.CPPTYPE_DOUBLE,
@@ -320,7 +333,7 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
             elif name == "foxglove.FrameTransform":
                 items = [dec]
             elif name == "foxglove.SceneUpdate":
-                scenes.append((msg.log_time, dec))
+                scenes.append((msg.log_time, dec, ch.topic))
                 continue
             elif name == "foxglove.Log":
                 logs[ch.topic].append((msg.log_time, dec))
@@ -373,7 +386,7 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
     first_time = min(
         [c.times[0] for c in channels.values() if c.times]
         + [e["times"][0] for e in tf.values() if e["times"]]
-        + [s[0] for s in scenes[:1]],
+        + [x[0] for x in scenes[:1]],
         default=0,
     )
     epochs: dict[str, int] = {}
@@ -408,13 +421,27 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
 
     # One application id for all polhode recordings (the viewer keys blueprints by it), and a
     # recording id from the file's content, so converting the same log again gives the same id.
+    # The entity roots of each run's scenes, split between the body's view (`/scene`) and the
+    # orbit view (`/earth`, `/orbit_scene`), and the orbit's size (to place the camera).
+    views: dict[str, dict] = defaultdict(lambda: dict(body=set(), orbit=set(), radius=0.0))
+    for _, su, topic in scenes:
+        v = views[run_of_topic(topic)]
+        orbit_topic = any(prefix_of(topic, leaf) is not None for leaf in ORBIT_SCENE_LEAVES)
+        for ent in su.entities:
+            root = frame_path(ent.frame_id) + "/" + part(ent.id or "entity")
+            v["orbit" if orbit_topic else "body"].add(root)
+            if orbit_topic:
+                for line in ent.lines:
+                    for q in line.points:
+                        v["radius"] = max(v["radius"], math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z))
+
     rec = rr.RecordingStream("polhode", recording_id=f"polhode-{digest[:16]}")
     rec.set_log_time_enabled(False)
     rec.set_log_tick_enabled(False)
     scen_name = metadata.get("polhode", {}).get("scenario", src.stem)
     blueprint = build_blueprint(
         prefixes, channels, tf, frame_path, run_of_frame, play_state, attachments,
-        body_sizes(scenes, run_of_frame),
+        body_sizes(scenes, run_of_frame), views,
     )
     rec.save(str(dst), default_blueprint=blueprint)
     rec.send_recording_name(scen_name)
@@ -457,7 +484,7 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
     roots_by_id: dict[str, set[str]] = defaultdict(set)
     root_epoch: dict[str, int] = {}
     updates = []
-    for t, su in scenes:
+    for t, su, topic in scenes:
         for d in su.deletions:
             targets = (
                 [r for r in known]
@@ -503,7 +530,8 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
         for j, name in enumerate(c.fields):
             path = f"{topic}/{part(name)}"
             rec.send_columns(path, indexes=index, columns=rr.Scalars.columns(scalars=v[:, j]))
-            label, color = SERIES_STYLE.get(name, (name, None)) if topic.endswith("/telemetry") else (name, None)
+            style = SERIES_STYLE if topic.endswith("/telemetry") else ORBIT_STYLE if topic.endswith("/orbit") else {}
+            label, color = style.get(name, (name, None))
             rec.log(path, rr.SeriesLines(names=label, colors=[_rgb(color)] if color else None), static=True)
             n_scalars += len(c.times)
 
@@ -541,7 +569,7 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
 def body_sizes(scenes, run_of_frame) -> dict[str, float]:
     """Largest dimension of each run's first drawn cube or cylinder (to place the camera)."""
     sizes: dict[str, float] = {}
-    for _, su in scenes:
+    for _, su, _ in scenes:
         for ent in su.entities:
             p = run_of_frame(ent.frame_id)
             if p not in sizes:
@@ -564,8 +592,9 @@ def _repeated(fd) -> bool:
 # ---------------------------------------------------------------------------------------------
 
 
-def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state, attachments, sizes):
-    """One layout per run: 3D view and main plots, with tabs for the rest."""
+def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state, attachments, sizes, views):
+    """One layout per run: 3D view and main plots, with tabs for the rest; with an orbit, the
+    orbit view under the body's and the attitude relative to LVLH among the main plots."""
 
     def series(view_name, topic, names):
         c = channels.get(topic)
@@ -586,10 +615,20 @@ def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state
         frames = [f for f in tf if run_of_frame(f) == p] or list(tf)
         body = [frame_path(f) for f in frames]
         size = sizes.get(p, 1.0)
+        v = views.get(p, dict(body=set(), orbit=set(), radius=0.0))
+        # The body's view is centred on the frame its scene is drawn in (`world`, the parent of
+        # `body`), without the orbit view's entities.
+        body_frames = [f for f in frames if f.split("/")[-1] == "body" and f in tf]
+        if body_frames:
+            world = frame_path(tf[body_frames[0]]["parent"])
+            origin, contents = world, [world + "/**"] + [f"- {r}/**" for r in sorted(v["orbit"])]
+        else:
+            origin = "/" + (body[0].split("/")[1] if body else "world")
+            contents = [b + "/**" for b in body] or ["/**"]
         view3d = rrb.Spatial3DView(
             name="Body in world frame (ω orange, H blue, effectors red)",
-            origin="/" + (body[0].split("/")[1] if body else "world"),
-            contents=[b + "/**" for b in body] or ["/**"],
+            origin=origin,
+            contents=contents,
             line_grid=rrb.LineGrid3D(visible=True),
             # From the x-y diagonal, 30 degrees above the x-y plane, as in the Foxglove layout, at
             # a distance scaled by the body's size.
@@ -599,13 +638,17 @@ def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state
                 eye_up=(0.0, 0.0, 1.0),
             ),
         )
+        energies = series("Dissipated and elastic energy (J)", tel, ["dissipated_energy", "elastic_energy"])
+        lvlh = series("Attitude relative to LVLH (roll, pitch, yaw; deg)", f"{p}/orbit", list(ORBIT_STYLE))
         main = [
             series("ω body components (rad/s)", tel, ["omega_x", "omega_y", "omega_z"]),
             series("Nutation angle, spin axis to H (deg)", tel, ["nutation_angle_deg"]),
             series("Kinetic energy T (J) and |H| (N m s)", tel, ["kinetic_energy", "h_norm"]),
-            series("Dissipated and elastic energy (J)", tel, ["dissipated_energy", "elastic_energy"]),
+            lvlh or energies,
         ]
         tabs = [rrb.TextLogView(name="Log", origin=f"{p}/log")]
+        if lvlh:
+            tabs.append(energies)
         tabs.append(series("Relative drifts", tel, ["drift_h_rel", "drift_energy_rel", "q_norm_error"]))
         tabs.append(
             series(
@@ -621,7 +664,32 @@ def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state
         if attachments:
             tabs.append(rrb.TextDocumentView(name="Scenario", origin="/attachments"))
         tabs.append(rrb.TextDocumentView(name="Metadata", origin="/metadata"))
-        left = rrb.Vertical(view3d, rrb.Tabs(*[t for t in tabs if t]), row_shares=[3, 1])
+        if v["orbit"]:
+            # The Earth-centred frame: the root of the body's world frame.
+            eci = "/" + origin.split("/")[1]
+            a = v["radius"] or 7.0e6
+            # The camera looks at the Earth's centre from over the spacecraft's last position,
+            # raised toward the north, so the marker and its axes are in front of the Earth.
+            world_tf = tf.get(body_frames[0] and tf[body_frames[0]]["parent"], {})
+            last = world_tf.get("translations", [(a, a, a)])[-1]
+            n = math.sqrt(sum(x * x for x in last)) or 1.0
+            d = [last[0] / n, last[1] / n, last[2] / n + 0.5]
+            m = math.sqrt(sum(x * x for x in d))
+            eye = tuple(2.9 * a * x / m for x in d)
+            orbit3d = rrb.Spatial3DView(
+                name="Orbit in eci: Earth to scale, path (cyan), spacecraft (magenta), body axes",
+                origin=eci,
+                contents=[eci + "/**"] + [f"- {r}/**" for r in sorted(v["body"])],
+                line_grid=rrb.LineGrid3D(visible=False),
+                eye_controls=rrb.EyeControls3D(
+                    position=eye,
+                    look_target=(0.0, 0.0, 0.0),
+                    eye_up=(0.0, 0.0, 1.0),
+                ),
+            )
+            left = rrb.Vertical(view3d, orbit3d, rrb.Tabs(*[t for t in tabs if t]), row_shares=[5, 5, 2])
+        else:
+            left = rrb.Vertical(view3d, rrb.Tabs(*[t for t in tabs if t]), row_shares=[3, 1])
         right = rrb.Vertical(*[v for v in main if v])
         return rrb.Horizontal(left, right, column_shares=[55, 45], name=p.strip("/") or "run")
 

@@ -10,12 +10,15 @@
 # 3. converts every log to .rrd (mcap_to_rrd.py), `rerun rrd verify` on each, and check.py:
 #    /tf arrives as Transform3D and every telemetry field is there with the MCAP's values,
 #    both in the raw MCAP as Rerun reads it and in the converted recording;
-# 4. a headless screenshot of explorer1-pydy's recording, checked (body, plots), to OUT.
+# 4. a headless screenshot of explorer1-pydy's recording, checked (body, plots), to OUT, and one
+#    of a scenario in orbit (gravity-gradient-smallsat, ORBIT_DURATION s), checked (body, Earth,
+#    orbit path, marker, plots), to OUT_ORBIT.
 # Prints PASS or FAIL with timings; exit code 0 only on PASS. Idempotent.
 #
 # Environment: POLHODE (binary; default <repo>/target/release/polhode, built if missing and
-# cargo exists), OUT (default <repo>/docs/figures/viewing/rerun.png), LOGS (work directory,
-# default scripts/viewers/rerun/out), DURATION (default 5), PYTHON (default python3).
+# cargo exists), OUT (default <repo>/docs/figures/viewing/rerun.png), OUT_ORBIT (default
+# rerun-orbit.png beside OUT), LOGS (work directory, default scripts/viewers/rerun/out),
+# DURATION (default 5), ORBIT_DURATION (default 3400), PYTHON (default python3).
 set -euo pipefail
 
 here="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")" && pwd)"
@@ -26,6 +29,9 @@ out="${OUT:-${repo}/docs/figures/viewing/rerun.png}"
 duration="${DURATION:-5}"
 python="${PYTHON:-python3}"
 flagship="explorer1-pydy"
+orbit_flagship="gravity-gradient-smallsat"
+out_orbit="${OUT_ORBIT:-$(dirname "${out}")/rerun-orbit.png}"
+orbit_duration="${ORBIT_DURATION:-3400}"
 
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 seconds() { local d=$(($(now_ms) - $1)); printf '%d.%01d s' $((d / 1000)) $((d % 1000 / 100)); }
@@ -103,7 +109,11 @@ for s in "${scenarios[@]}"; do
     names+=("$n")
     rm -f "${logs}/${n}.mcap" "${logs}/${n}.rrd" "${logs}/${n}.check.txt"  # no stale results
     args=(run "$s" --out "${logs}/${n}.mcap" --quiet)
-    [[ "$n" == "${flagship}" ]] || args+=(--duration "${duration}")
+    if [[ "$n" == "${orbit_flagship}" ]]; then
+        args+=(--duration "${orbit_duration}")
+    elif [[ "$n" != "${flagship}" ]]; then
+        args+=(--duration "${duration}")
+    fi
     if ! "${polhode}" "${args[@]}"; then fail "polhode run ${n}"; continue; fi
     # Every topic row of the report must say ok (the exit code covers structural errors).
     if report="$("${rerun}" mcap check --full "${logs}/${n}.mcap" 2>&1)" &&
@@ -121,7 +131,7 @@ for n in "${names[@]}"; do
     [[ -f "${logs}/${n}.mcap" ]] || continue
     extra=()
     # The flagship's recording is the one shot: start with the time cursor at the end.
-    [[ "$n" == "${flagship}" ]] && extra=(--play-state following)
+    [[ "$n" == "${flagship}" || "$n" == "${orbit_flagship}" ]] && extra=(--play-state following)
     if ! "${py}" "${here}/mcap_to_rrd.py" "${logs}/${n}.mcap" -o "${logs}/${n}.rrd" "${extra[@]}"; then
         fail "convert ${n}"; continue
     fi
@@ -157,46 +167,51 @@ n_series=$( (grep -o ' - /telemetry/[a-z0-9_]* - data columns: \[Scalars:scalars
 rm -f "${flag}.raw.rrd"
 done_phase "rerun rrd print"
 
-# --- 4. headless screenshot ------------------------------------------------------------------
+# --- 4. headless screenshots ----------------------------------------------------------------
 phase "screenshot"
-mkdir -p "$(dirname "${out}")"
+mkdir -p "$(dirname "${out}")" "$(dirname "${out_orbit}")"
 xdg="$(mktemp -d)"; chmod 700 "${xdg}"
-shot="${logs}/${flagship}.screenshot.png"
-attempts=(1 2)
-ok=""
-[[ -s "${flag}.rrd" ]] || { echo "no ${flag}.rrd to show"; attempts=(); }
-for attempt in "${attempts[@]}"; do
-    rm -f "${shot}"
-    # --new: a viewer of its own even if one already listens on the default port.
-    # RUST_LOG=error: no notification toasts over the views.
-    if XDG_RUNTIME_DIR="${xdg}" RUST_LOG=error timeout 300 xvfb-run -a -s "-screen 0 1920x1200x24" \
-        "${rerun}" "${flag}.rrd" --new --bind 127.0.0.1 --renderer vulkan \
-        --window-size 1600x1000 --screenshot-to "${shot}" > "${logs}/screenshot.log" 2>&1 &&
-        [[ -s "${shot}" ]]; then
-        # The viewer renders at 2 pixels per point: scale to 1600 px wide, and write OUT only
-        # once the image passes.
-        small="${logs}/${flagship}.screenshot.small.png"
-        "${py}" -c 'import sys; from PIL import Image; im = Image.open(sys.argv[1]).convert("RGB")
+# shoot NAME OUT [check.py options]: the recording NAME.rrd on screen, checked, written to OUT.
+shoot() {
+    local name="$1" dest="$2"; shift 2
+    local rec="${logs}/${name}" shot="${logs}/${name}.screenshot.png" ok="" attempt
+    local attempts=(1 2)
+    [[ -s "${rec}.rrd" ]] || { echo "no ${rec}.rrd to show"; attempts=(); }
+    for attempt in "${attempts[@]}"; do
+        rm -f "${shot}"
+        # --new: a viewer of its own even if one already listens on the default port.
+        # RUST_LOG=error: no notification toasts over the views.
+        if XDG_RUNTIME_DIR="${xdg}" RUST_LOG=error timeout 300 xvfb-run -a -s "-screen 0 1920x1200x24" \
+            "${rerun}" "${rec}.rrd" --new --bind 127.0.0.1 --renderer vulkan \
+            --window-size 1600x1000 --screenshot-to "${shot}" > "${logs}/screenshot.log" 2>&1 &&
+            [[ -s "${shot}" ]]; then
+            # The viewer renders at 2 pixels per point: scale to 1600 px wide, and write the
+            # destination only once the image passes.
+            local small="${logs}/${name}.screenshot.small.png"
+            "${py}" -c 'import sys; from PIL import Image; im = Image.open(sys.argv[1]).convert("RGB")
 if im.width > 1600: im = im.resize((1600, round(im.height * 1600 / im.width)), Image.LANCZOS)
 im.save(sys.argv[2], optimize=True)' \
-            "${shot}" "${small}"
-        if "${py}" "${here}/check.py" "${flag}.mcap" --no-raw --png "${small}" > "${logs}/screenshot.check.txt"; then
-            cp "${small}" "${out}.tmp" && mv "${out}.tmp" "${out}"
-            ok=1; break
+                "${shot}" "${small}"
+            if "${py}" "${here}/check.py" "${rec}.mcap" --no-raw --png "${small}" "$@" > "${logs}/${name}.screenshot.check.txt"; then
+                cp "${small}" "${dest}.tmp" && mv "${dest}.tmp" "${dest}"
+                ok=1; break
+            fi
+            cat "${logs}/${name}.screenshot.check.txt"
+        else
+            tail -n 20 "${logs}/screenshot.log"
         fi
-        cat "${logs}/screenshot.check.txt"
+        echo "screenshot ${name} attempt ${attempt} failed"
+    done
+    if [[ -n "${ok}" ]]; then
+        grep -v '^check:' "${logs}/${name}.screenshot.check.txt"
+        echo "  wrote ${dest} ($(stat -c %s "${dest}") bytes)"
     else
-        tail -n 20 "${logs}/screenshot.log"
+        fail "screenshot ${name}"
     fi
-    echo "screenshot attempt ${attempt} failed"
-done
+}
+shoot "${flagship}" "${out}"
+shoot "${orbit_flagship}" "${out_orbit}" --orbit
 rm -rf "${xdg}"
-if [[ -n "${ok}" ]]; then
-    grep -v '^check:' "${logs}/screenshot.check.txt"
-    echo "  wrote ${out} ($(stat -c %s "${out}") bytes)"
-else
-    fail "screenshot"
-fi
 done_phase "screenshot"
 
 # --- summary ---------------------------------------------------------------------------------
@@ -208,4 +223,4 @@ if ((${#failed[@]})); then
     printf '  %s\n' "${failed[@]}"
     exit 1
 fi
-echo "PASS: ${#names[@]} scenarios logged, checked by Rerun, converted and verified; screenshot ${out}"
+echo "PASS: ${#names[@]} scenarios logged, checked by Rerun, converted and verified; screenshots ${out}, ${out_orbit}"
