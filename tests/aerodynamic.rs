@@ -681,7 +681,8 @@ fn box_and_cylinder_agree_with_a_ray_cast_silhouette() {
 /// of a 10 kg spacecraft puts the hub's centre of mass at (−0.1, 0, 0) m from O, so the unit
 /// cube's centre is at (0.1, 0, 0) from the hub's. The wind w ŷ (identity attitude, t = 0)
 /// takes the +y face (1 m²) at (0.1, 0.5, 0): F = (0, −f, 0), f = q 1 m², and
-/// τ = (0.1, 0.5, 0) × F = (0, 0, −0.1 f).
+/// τ = (0.1, 0.5, 0) × F = (0, 0, −0.1 f). A constant-area centre of pressure written about O
+/// moves with it.
 #[test]
 fn with_a_composite_body_the_shape_stays_where_it_was_written() {
     let (_, q) = dynamic_pressure_400km();
@@ -702,6 +703,25 @@ effectors:
         want,
         1e-9,
         "composite",
+    );
+    // A constant area of 1 m² with its centre of pressure written at O is moved the same
+    // way, to (0.1, 0, 0): τ = (0.1, 0, 0) × (0, −f, 0) = (0, 0, −0.1 f).
+    let s = load(
+        "name: a
+body: {composite: true, mass: 10.0, principal: [5.0, 6.0, 7.0]}
+orbit: {semi_major_axis_km: 6778.137}
+initial: {omega: [0, 0, 0.1]}
+duration: 1
+effectors:
+  - aerodynamic: {drag_coefficient: 2.2, area: 1, center_of_pressure: [0, 0, 0]}
+  - spring_mass_damper: {mass: 2.0, position: [0.4, 0, 0], direction: [0, 0, 1], stiffness: 10.0, damping: 0.1}
+",
+    );
+    close(
+        torque_of(&s, &UnitQuaternion::identity()),
+        want,
+        1e-9,
+        "composite, constant area",
     );
 }
 
