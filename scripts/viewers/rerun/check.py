@@ -151,10 +151,14 @@ def check_raw(mcap: Path, ref: dict) -> None:
     ents = by_entity(rc.McapReader(str(mcap)).stream())
     for frame, (t_ref, q_ref) in ref["tf"].items():
         topic = next((p for p in ents if p.endswith("/tf") and frame.startswith(p[1:-3])), "/tf")
-        t, arr = column(ents.get(topic, []), "Transform3D:quaternion")
+        batches = ents.get(topic, [])
+        if not batches:
+            # A frame the runs of a campaign file share (`world`, `ecef`): in every run's /tf.
+            batches = [b for p in ents if p.endswith("/tf") for b in ents[p]]
+        t, arr = column(batches, "Transform3D:quaternion")
         # A /tf message with several transforms (body and lvlh, for a scenario with an orbit)
         # gives one row per transform: keep this frame's rows.
-        _, child = column(ents.get(topic, []), "Transform3D:child_frame")
+        _, child = column(batches, "Transform3D:child_frame")
         if arr is not None and child is not None and len(child) == len(arr):
             keep = np.array([bool(c) and c[0] == frame for c in child.to_pylist()], bool)
             t, arr = t[keep], arr.filter(pa.array(keep))
@@ -226,7 +230,13 @@ def check_rrd(rrd: Path, ref: dict) -> None:
         if topic.endswith(("/earth", "/orbit_scene")):
             # The orbit view (docs/logs.md): the Earth's sphere once; per update the orbit path
             # and the spacecraft marker.
-            want = {"/earth": ["/earth/spheres"], "/orbit_scene": ["/orbit_path/lines", "/spacecraft_marker/spheres"]}
+            # (A campaign run's entities in the shared frames carry the run's name.)
+            run = topic[: topic.rfind("/")].strip("/")
+            tag = f"_{run}" if run else ""
+            want = {
+                "/earth": [f"/earth{tag}/spheres"],
+                "/orbit_scene": [f"/orbit_path{tag}/lines", f"/spacecraft_marker{tag}/spheres"],
+            }
             for leaf in want[topic[topic.rfind("/"):]]:
                 p = next((p for p in ents if p.endswith(leaf)), None)
                 col = next((c for c in ents[p][0].schema.names if c.endswith((":centers", ":strips"))), None) if p else None

@@ -411,6 +411,16 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
                 best = p
         return best
 
+    def entity_root(ent, topic: str) -> str:
+        """The entity path of a scene entity: under its frame, named by its id; an entity of a
+        campaign run drawn in a frame the runs share (`eci`, `world`) also gets the run's name,
+        so the runs' entities stay apart."""
+        name = part(ent.id or "entity")
+        run = run_of_topic(topic)
+        if run and run_of_frame(ent.frame_id) != run:
+            name += "_" + part(run.strip("/"))
+        return frame_path(ent.frame_id) + "/" + name
+
     # Frames -> entity paths, following the /tf tree (roots at the top level).
     def frame_path(frame: str, seen: tuple = ()) -> str:
         e = tf.get(frame)
@@ -428,7 +438,7 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
         v = views[run_of_topic(topic)]
         orbit_topic = any(prefix_of(topic, leaf) is not None for leaf in ORBIT_SCENE_LEAVES)
         for ent in su.entities:
-            root = frame_path(ent.frame_id) + "/" + part(ent.id or "entity")
+            root = entity_root(ent, topic)
             v["orbit" if orbit_topic else "body"].add(root)
             if orbit_topic:
                 for line in ent.lines:
@@ -470,7 +480,9 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
     for frame, e in tf.items():
         rec.send_columns(
             frame_path(frame),
-            indexes=timelines(e["times"], epochs[run_of_frame(frame)]),
+            # Frames shared by the runs of a campaign file (`world`, and `eci`'s children with
+            # an orbit) take the first run's epoch: the runs share the scenario's epoch.
+            indexes=timelines(e["times"], epochs.get(run_of_frame(frame), epochs[prefixes[0]])),
             columns=rr.Transform3D.columns(
                 translation=np.array(e["translations"]), quaternion=np.array(e["quaternions"])
             ),
@@ -493,11 +505,11 @@ def convert(src: Path, dst: Path, play_state: str | None = None) -> dict:
             )
             updates.append((t, targets, None))
         for ent in su.entities:
-            root = frame_path(ent.frame_id) + "/" + part(ent.id or "entity")
+            root = entity_root(ent, topic)
             inst = scene_instances(ent)
             known[root].update(inst)
             roots_by_id[ent.id].add(root)
-            root_epoch[root] = epochs[run_of_frame(ent.frame_id)]
+            root_epoch[root] = epochs.get(run_of_frame(ent.frame_id), epochs[prefixes[0]])
             updates.append((t, [root], inst))
     for t, targets, inst in updates:
         for root in targets:
@@ -619,9 +631,12 @@ def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state
         # The body's view is centred on the frame its scene is drawn in (`world`, the parent of
         # `body`), without the orbit view's entities.
         body_frames = [f for f in frames if f.split("/")[-1] == "body" and f in tf]
+        every_orbit_root = sorted(r for w in views.values() for r in w["orbit"])
         if body_frames:
             world = frame_path(tf[body_frames[0]]["parent"])
-            origin, contents = world, [world + "/**"] + [f"- {r}/**" for r in sorted(v["orbit"])]
+            own = [b for b in body if b.startswith(world + "/")]
+            origin = world
+            contents = [b + "/**" for b in own] + [f"- {r}/**" for r in every_orbit_root]
         else:
             origin = "/" + (body[0].split("/")[1] if body else "world")
             contents = [b + "/**" for b in body] or ["/**"]
@@ -679,7 +694,10 @@ def build_blueprint(prefixes, channels, tf, frame_path, run_of_frame, play_state
             orbit3d = rrb.Spatial3DView(
                 name="Orbit in eci: Earth to scale, path (cyan), spacecraft (magenta), body axes",
                 origin=eci,
-                contents=[eci + "/**"] + [f"- {r}/**" for r in sorted(v["body"])],
+                # This run's orbit entities; no body geometry (metres across), no other run's.
+                contents=[eci + "/**"]
+                + [f"- {r}/**" for w in views.values() for r in sorted(w["body"])]
+                + [f"- {r}/**" for r in every_orbit_root if r not in v["orbit"]],
                 line_grid=rrb.LineGrid3D(visible=False),
                 eye_controls=rrb.EyeControls3D(
                     position=eye,
