@@ -252,6 +252,34 @@ fn bench_environment_rhs(repeats: usize) {
     }
 }
 
+/// The orbit angle's sine and cosine, the largest single part of the gravity gradient in a
+/// circular orbit: the table-driven `polhode::orbit::sincos` against the C library's, at
+/// the angles a LEO orbit reaches in a day.
+fn bench_sin_cos(repeats: usize) {
+    let calls = 100_000;
+    let angle = |k: usize| black_box(0.3 + k as f64 * 1.1e-3 * 0.37);
+    let mut table = || {
+        for k in 0..calls {
+            black_box(polhode::orbit::sincos::sin_cos(angle(k)));
+        }
+    };
+    let mut library = || {
+        for k in 0..calls {
+            black_box(angle(k).sin_cos());
+        }
+    };
+    let (mut t_best, mut l_best) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        t_best = t_best.min(min_time(1, &mut table));
+        l_best = l_best.min(min_time(1, &mut library));
+    }
+    let (t_ns, l_ns) = (t_best / calls as f64 * 1e9, l_best / calls as f64 * 1e9);
+    println!(
+        "  sin_cos of the orbit angle: table {t_ns:.1} ns, C library {l_ns:.1} ns, ratio {:.2}",
+        t_ns / l_ns
+    );
+}
+
 /// What aerodynamic drag adds to a rigid body's right-hand side: one constant area, and the
 /// facets of a box and of a cylinder (`from_shape: true`), in LEO.
 fn bench_drag_rhs(repeats: usize) {
@@ -312,7 +340,12 @@ fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 15 };
     bench_environment_rhs(repeats);
+    bench_sin_cos(repeats);
     bench_drag_rhs(repeats);
+    // `--environment`: the environment torques alone.
+    if std::env::args().any(|a| a == "--environment") {
+        return;
+    }
     bench_effector_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(

@@ -38,7 +38,7 @@ pub trait EnvironmentTorque: Debug + Send + Sync {
 /// C(q)ᵀ v: the inertial vector `v` in body axes, for the integrated, not quite unit,
 /// quaternion `q` (w, x, y, z). For such a q, (w² − |u|²) v + 2 (u·v) u − 2 w (u × v) is |q|²
 /// times the rotated vector; dividing by |q|² normalises exactly, without a square root.
-#[inline]
+#[inline(always)]
 pub fn to_body(q: &[f64], v: &Vector3<f64>) -> Vector3<f64> {
     let (w, u) = (q[0], Vector3::new(q[1], q[2], q[3]));
     let u2 = u.norm_squared();

@@ -34,12 +34,11 @@ pub struct GravityGradient {
 impl GravityGradient {
     /// The torque (N m, body axes) at time `t` (s) for the attitude `q` (w, x, y, z; body →
     /// inertial; normalised here).
-    #[inline]
+    #[inline(always)]
     pub fn torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        let (r_hat_n, radius) = self.orbit.direction(t);
+        let (r_hat_n, mu_over_r3) = self.orbit.tidal_direction(t);
         let r_hat = to_body(q, &r_hat_n);
-        let coefficient = 3.0 * self.orbit.body().mu / (radius * radius * radius);
-        coefficient * r_hat.cross(&(self.inertia * r_hat))
+        (3.0 * mu_over_r3) * r_hat.cross(&(self.inertia * r_hat))
     }
 
     /// The gradient of the central body's field at the orbit position, in body axes (1/s²):

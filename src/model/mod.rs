@@ -379,6 +379,11 @@ pub struct Spacecraft {
     euler_coefficients: Option<[f64; 3]>,
     /// Offset of each effector's states in the state vector.
     offsets: Vec<usize>,
+    /// Number of states of each effector (its `num_states`, kept to spare a virtual call per
+    /// right-hand side).
+    lens: Vec<usize>,
+    /// Length of each effector's scratch space (its `scratch_len`, likewise).
+    scratch_lens: Vec<usize>,
     /// Offset of each effector's scratch space.
     scratch_offsets: Vec<usize>,
     scratch_len: usize,
@@ -408,6 +413,8 @@ impl Spacecraft {
             effectors: Vec::new(),
             motion: None,
             offsets: Vec::new(),
+            lens: Vec::new(),
+            scratch_lens: Vec::new(),
             scratch_offsets: Vec::new(),
             scratch_len: 0,
             translation: false,
@@ -448,8 +455,10 @@ impl Spacecraft {
         self.torque_only =
             effector.torque_only() && (self.effectors.is_empty() || self.torque_only);
         self.offsets.push(self.dim);
+        self.lens.push(effector.num_states());
         self.dim += effector.num_states();
         self.scratch_offsets.push(self.scratch_len);
+        self.scratch_lens.push(effector.scratch_len());
         self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
         Ok(())
@@ -605,9 +614,9 @@ impl Spacecraft {
             let s = self.scratch_offsets[k];
             e.couple(
                 hub,
-                &y[off..off + e.num_states()],
+                &y[off..off + self.lens[k]],
                 &mut coupling,
-                &mut scratch[s..s + e.scratch_len()],
+                &mut scratch[s..s + self.scratch_lens[k]],
             );
         }
         coupling
@@ -626,21 +635,34 @@ impl Spacecraft {
             attitude: &y[3..7],
         };
         let mut torques = [Vector3::zeros(); MAX_FAST_TORQUES];
-        let mut total = -omega.cross(&(self.hub.inertia * omega));
+        let mut total = Vector3::zeros();
         for (k, e) in self.effectors.iter().enumerate() {
             let off = self.offsets[k];
-            torques[k] = e.torque(&hub, &y[off..off + e.num_states()]);
+            torques[k] = e.torque(&hub, &y[off..off + self.lens[k]]);
             total += torques[k];
         }
+        // ω̇ = I⁻¹(−ω × Iω) + I⁻¹ Σ τ: with principal body axes, Euler's 3-term form plus the
+        // diagonal inverse.
+        let angular = if self.euler_coefficients.is_some() {
+            let inv = &self.hub.inertia_inv;
+            self.rigid_omega_dot(&omega)
+                + Vector3::new(
+                    inv[(0, 0)] * total[0],
+                    inv[(1, 1)] * total[1],
+                    inv[(2, 2)] * total[2],
+                )
+        } else {
+            self.hub.inertia_inv * (total - omega.cross(&(self.hub.inertia * omega)))
+        };
         let accel = HubAcceleration {
             linear: Vector3::zeros(),
-            angular: self.hub.inertia_inv * total,
+            angular,
             tidal_power: 0.0,
         };
         for (k, e) in self.effectors.iter().enumerate() {
             let off = self.offsets[k];
-            let n = e.num_states();
-            let scratch = &torques[k].as_slice()[..e.scratch_len().min(3)];
+            let n = self.lens[k];
+            let scratch = &torques[k].as_slice()[..self.scratch_lens[k].min(3)];
             e.derivatives(
                 &hub,
                 &accel,
@@ -679,13 +701,13 @@ impl Spacecraft {
             }
             for (k, e) in self.effectors.iter().enumerate() {
                 let off = self.offsets[k];
-                let n = e.num_states();
+                let n = self.lens[k];
                 let s = self.scratch_offsets[k];
                 e.derivatives(
                     &hub,
                     &accel,
                     &y[off..off + n],
-                    &scratch[s..s + e.scratch_len()],
+                    &scratch[s..s + self.scratch_lens[k]],
                     &mut dydt[off..off + n],
                 );
             }

@@ -28,6 +28,7 @@ mod earth;
 mod elements;
 pub mod kepler;
 pub mod magnetic;
+pub mod sincos;
 
 pub use body::CentralBody;
 pub use earth::{earth_rotation_angle, gmst_iau82};
@@ -117,6 +118,8 @@ pub struct Orbit {
     sin_i: f64,
     /// Perifocal axes at t = 0 (fixed without J2).
     axes0: [Vector3<f64>; 3],
+    /// μ/a³ (1/s²): μ/r³ at every instant of a circular orbit.
+    mu_over_a3: f64,
 }
 
 /// The Kepler solution at one instant.
@@ -174,6 +177,7 @@ impl Orbit {
             cos_i,
             sin_i,
             axes0: perifocal_axes(elements.raan, cos_i, sin_i, elements.arg_perigee),
+            mu_over_a3: body.mu / (a * a * a),
         })
     }
 
@@ -228,8 +232,8 @@ impl Orbit {
         let e = self.elements.eccentricity;
         let m = self.mean_anomaly(t);
         let (sin_e, cos_e) = if e == 0.0 {
-            // Circular: E = M, no Kepler solve.
-            m.sin_cos()
+            // Circular: E = M, no Kepler solve; the table-driven sin/cos (a few ulps).
+            sincos::sin_cos(m)
         } else {
             let s = kepler::solve(m, e);
             (s.sin_e, s.cos_e)
@@ -261,8 +265,14 @@ impl Orbit {
     /// The unit vector from the body's centre to the spacecraft (ECI) and the distance (m) at
     /// time t: what the environment torques need, without the velocity. Equal to
     /// [`Orbit::state`]'s position over its norm.
-    #[inline]
+    #[inline(always)]
     pub fn direction(&self, t: f64) -> (Vector3<f64>, f64) {
+        if self.elements.eccentricity == 0.0 && !self.j2_secular {
+            // Circular with fixed axes: a (P̂ cos M + Q̂ sin M), nothing else to form.
+            let (sin_m, cos_m) = sincos::sin_cos(self.mean_anomaly(t));
+            let [p, q, _] = &self.axes0;
+            return (p * cos_m + q * sin_m, self.elements.semi_major_axis);
+        }
         let ph = self.phase(t);
         let (a, e) = (self.elements.semi_major_axis, self.elements.eccentricity);
         let [p, q, _] = ph.axes;
@@ -272,6 +282,20 @@ impl Orbit {
         }
         let r = p * (a * (ph.cos_e - e)) + q * (self.b * ph.sin_e);
         (r / ph.r, ph.r)
+    }
+
+    /// The unit vector from the body's centre to the spacecraft (ECI) and μ/r³ (1/s²) at time
+    /// t: what the gravity gradient needs. For a circular orbit μ/r³ is the constant μ/a³,
+    /// with no division per call.
+    #[inline(always)]
+    pub fn tidal_direction(&self, t: f64) -> (Vector3<f64>, f64) {
+        let (r_hat, radius) = self.direction(t);
+        let mu_over_r3 = if self.elements.eccentricity == 0.0 {
+            self.mu_over_a3
+        } else {
+            self.body.mu / (radius * radius * radius)
+        };
+        (r_hat, mu_over_r3)
     }
 
     /// Distance from the body's centre (m).
