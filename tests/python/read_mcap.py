@@ -44,7 +44,9 @@ What it checks:
   Metadata and attachments
     - a metadata record "polhode" with keys version, scenario, integrator,
       epoch, quaternion_convention, status; if `epoch` is an ISO 8601 date-time,
-      the first /telemetry log time must equal it (sim time 0 at the epoch);
+      the first /telemetry log time must equal it (sim time 0 at the epoch), or,
+      for an epoch before 1970 and only then, `log_time_origin` must be present,
+      be 1970-01-01T00:00:00Z and be the first log time;
     - an attachment "scenario.yaml" with non-empty UTF-8 data.
   /tf (foxglove.FrameTransforms)
     - exactly one transform, parent_frame_id "world", child_frame_id "body",
@@ -598,13 +600,25 @@ class McapCheck:
             )
         epoch = self.polhode_metadata.get("epoch")
         epoch_ns = _parse_epoch_ns(epoch) if epoch else None
-        if epoch_ns is not None and self.telemetry:
+        # An epoch before 1970 cannot be an (unsigned) log time: the log is stamped from
+        # `log_time_origin` (1970-01-01) instead, and only then.
+        origin = self.polhode_metadata.get("log_time_origin")
+        if epoch_ns is not None and (epoch_ns < 0) != (origin is not None):
+            self.checks.fail(
+                "epoch",
+                f"metadata epoch {epoch!r} with log_time_origin {origin!r}: expected the "
+                "origin exactly when the epoch precedes 1970",
+            )
+        stamp_ns = _parse_epoch_ns(origin) if origin is not None else epoch_ns
+        if origin is not None and stamp_ns != 0:
+            self.checks.fail("epoch", f"log_time_origin {origin!r} is not 1970-01-01T00:00:00Z")
+        if stamp_ns is not None and self.telemetry:
             first = self.telemetry[0][0]
-            if first != epoch_ns:
+            if first != stamp_ns:
                 self.checks.fail(
                     "epoch",
                     f"first /telemetry log time {first} ns != metadata epoch {epoch!r} "
-                    f"({epoch_ns} ns)",
+                    f"(log time origin {stamp_ns} ns)",
                 )
 
     # ------------------------------------------------------ per-message checks
