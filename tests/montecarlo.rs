@@ -707,3 +707,83 @@ fn every_event_gets_its_own_charts() {
         serde_json::json!([])
     );
 }
+
+/// Orbit elements disperse like any numeric field: each run's drawn inclination, size and
+/// eccentricity, written into a plain scenario and run alone, give the campaign's final |H|
+/// and h_inertial exactly (the pitch rate at rest in LVLH is the orbit's rate, so |H| tells
+/// the orbits apart).
+#[test]
+fn orbit_elements_disperse_like_any_numeric_field() {
+    let dir = scratch("orbit");
+    let base = "name: mc-orbit
+body: {principal: [6.0, 8.0, 2.0]}
+orbit: {semi_major_axis_km: 6978.137, inclination_deg: 51.6, eccentricity: 0.0}
+initial:
+  frame: lvlh
+  omega: [0.0, 0.0, 0.0]
+  attitude: {w: 0.9990482215818578, x: 0.0, y: 0.043619387365336, z: 0.0}
+duration: 600
+integrator: {method: dop853, rtol: 1.0e-9, atol: 1.0e-12}
+output: {rate: 0.1}
+effectors:
+  - gravity_gradient: {}
+";
+    let yaml = format!(
+        "{base}montecarlo:
+  runs: 4
+  seed: 3
+  dispersions:
+    - {{path: \"orbit.inclination_deg\", normal: {{sd: 5.0}}}}
+    - {{path: \"orbit.semi_major_axis_km\", normal: {{sd: 100.0}}}}
+    - {{path: \"orbit.eccentricity\", uniform: {{min: 0.0, max: 0.05}}}}
+  final_telemetry: [h_norm]
+"
+    );
+    let scenario = dir.join("campaign.yaml");
+    std::fs::write(&scenario, yaml).unwrap();
+    let out = dir.join("out");
+    campaign(&[scenario.to_str().unwrap()], &out);
+    let csv = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut norms = Vec::new();
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let (i, a, e) = (
+            cells[col("orbit.inclination_deg")],
+            cells[col("orbit.semi_major_axis_km")],
+            cells[col("orbit.eccentricity")],
+        );
+        let single = base.replace(
+            "orbit: {semi_major_axis_km: 6978.137, inclination_deg: 51.6, eccentricity: 0.0}",
+            &format!("orbit: {{semi_major_axis_km: {a}, inclination_deg: {i}, eccentricity: {e}}}"),
+        );
+        let path = dir.join("single.yaml");
+        std::fs::write(&path, single).unwrap();
+        let summary = dir.join("single.json");
+        let o = polhode()
+            .args([
+                "run",
+                path.to_str().unwrap(),
+                "--no-log",
+                "--quiet",
+                "--summary",
+            ])
+            .arg(&summary)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        let expected = json(&summary)["final"]["h_norm"].as_f64().unwrap();
+        let got: f64 = cells[col("final_h_norm")].parse().unwrap();
+        assert_eq!(got, expected, "{line}");
+        norms.push(got);
+    }
+    assert_eq!(norms.len(), 4);
+    // Different orbits: different rates, so different |H|.
+    norms.sort_by(f64::total_cmp);
+    assert!(
+        norms.windows(2).all(|w| w[1] > w[0] * (1.0 + 1e-6)),
+        "{norms:?}"
+    );
+}
