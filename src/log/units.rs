@@ -242,8 +242,26 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("modal_appendage", "tip_lag") => {
             return fixed("Tip deflection along the lag direction", "m");
         }
-        ("wheel_damper", "rate") => {
+        ("wheel_damper" | "wheel", "rate") => {
             return fixed("Rotor rate about its axis relative to the body", "rad/s");
+        }
+        ("wheel", "momentum") => {
+            return fixed(
+                "Rotor's angular momentum relative to the body, I_a times the rate",
+                "N m s",
+            );
+        }
+        ("wheel", "motor_torque") => {
+            return fixed(
+                "Motor torque on the rotor (the body takes its opposite)",
+                "N m",
+            );
+        }
+        ("wheel", "friction_torque") => {
+            return fixed("Bearing friction torque opposing the rotor's rate", "N m");
+        }
+        ("wheel", "motor_work") => {
+            return fixed("Work done by the motor since the start", "J");
         }
         ("gravity_gradient", "torque_x") => {
             return fixed("Gravity-gradient torque on the hub, body x", "N m");

@@ -15,6 +15,10 @@ use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::Path;
 
+mod wheel;
+
+use wheel::MotorWheelSpec;
+
 /// One entry of `effectors:`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
@@ -27,6 +31,8 @@ pub enum EffectorSpec {
     SpringMassDamper(SpringMassSpec),
     /// Viscous wheel damper.
     WheelDamper(WheelSpec),
+    /// A driven rotor: motor (free, torque profile or speed hold) and bearing friction.
+    Wheel(Box<MotorWheelSpec>),
     /// Rigid rod on a hinge.
     HingedRod(HingedRodSpec),
     /// Modal cantilever beam.
@@ -560,6 +566,7 @@ pub(super) fn build(
             EffectorSpec::EnergySink(_) => "energy_sink",
             EffectorSpec::SpringMassDamper(_) => "spring_mass_damper",
             EffectorSpec::WheelDamper(_) => "wheel_damper",
+            EffectorSpec::Wheel(_) => "wheel",
             EffectorSpec::HingedRod(_) => "hinged_rod",
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
@@ -926,6 +933,9 @@ pub(super) fn build(
                     &[q0],
                     &[u0],
                 )));
+            }
+            EffectorSpec::Wheel(w) => {
+                wheel::build(&ck, w, name_of(&w.name), cx.shift, cx.hub, &mut out)?;
             }
             EffectorSpec::WheelDamper(w) => {
                 out.push(Box::new(WheelDamper {
