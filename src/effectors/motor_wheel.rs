@@ -191,6 +191,17 @@ impl Effector for MotorWheel {
             f * x[0],
         ]
     }
+    fn held_rotor_states(&self) -> Option<Vec<(usize, f64)>> {
+        // At the held rate the motor supplies the friction: K_i z = f(Ω_cmd) (with K_i = 0
+        // a proportional loop settles off its command, so no state holds the rate exactly).
+        match &self.mode {
+            MotorMode::SpeedHold(hold) if hold.ki > 0.0 => Some(vec![
+                (0, hold.rate),
+                (1, self.friction.torque(hold.rate) / hold.ki),
+            ]),
+            _ => None,
+        }
+    }
     fn validity(&self, x: &[f64]) -> Option<Validity> {
         self.max_speed.map(|max| Validity {
             value: x[0].abs(),

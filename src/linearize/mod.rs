@@ -164,8 +164,12 @@ struct Rotor {
     momentum_per_rate: Vector3<f64>,
     /// Viscous coefficient D (N m s/rad): the power it dissipates at Ω = 1 rad/s.
     damping: f64,
-    /// The relative rate the scenario starts it at, Ω₀ (rad/s).
+    /// Its relative rate at the equilibrium (rad/s): the scenario's Ω₀, or the rate its
+    /// motor holds.
     rate: f64,
+    /// The states its motor's loop holds the rate with (absolute indices, values); empty
+    /// for a coasting rotor.
+    held: Vec<(usize, f64)>,
 }
 
 /// The spacecraft's rotors: their momentum and dissipation per unit rate measured with the hub
@@ -176,18 +180,33 @@ fn rotors(sc: &Spacecraft) -> Vec<Rotor> {
     sc.effectors()
         .iter()
         .enumerate()
-        .filter(|(_, e)| e.kind() == "wheel_damper")
+        .filter(|(_, e)| matches!(e.kind(), "wheel_damper" | "wheel"))
         .map(|(k, e)| {
             let index = sc.effector_offset(k);
             let mut y = rest.clone();
             y[index] = 1.0;
             let unit = sc.invariants(0.0, &y);
+            let held: Vec<(usize, f64)> = e
+                .held_rotor_states()
+                .unwrap_or_default()
+                .into_iter()
+                .map(|(i, v)| (index + i, v))
+                .collect();
             Rotor {
                 name: e.name().to_string(),
                 index,
                 momentum_per_rate: unit.h_body - base.h_body,
-                damping: unit.dissipation_power - base.dissipation_power,
-                rate: e.initial_state().first().copied().unwrap_or(0.0),
+                // A held rotor keeps its rate: its motor supplies what the friction takes.
+                damping: if held.is_empty() {
+                    unit.dissipation_power - base.dissipation_power
+                } else {
+                    0.0
+                },
+                rate: held
+                    .first()
+                    .map(|&(_, v)| v)
+                    .unwrap_or_else(|| e.initial_state().first().copied().unwrap_or(0.0)),
+                held,
             }
         })
         .collect()
@@ -285,13 +304,6 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let principal_index = (0..3)
         .min_by(|&a, &b| (p[a] - i_s).abs().total_cmp(&(p[b] - i_s).abs()))
         .unwrap_or(2);
-    if !(spin_rate.is_finite() && spin_rate != 0.0) {
-        return Err(format!(
-            "the spin rate about the spin axis is {spin_rate} rad/s; a linearisation about \
-             steady spin needs a non-zero rate"
-        ));
-    }
-
     // Rotors spinning relative to the hub make a gyrostat: they keep their relative rate in
     // the steady state, and their momentum must lie along ŝ for the hub's steady spin to be
     // about ŝ (ω × (Iω + h) = 0 with Iŝ ∥ ŝ needs h ∥ ŝ).
@@ -321,6 +333,14 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         .iter()
         .map(|r| r.rate * r.momentum_per_rate.dot(&s))
         .sum();
+    // A despun platform (spin rate 0) is a steady state when rotors carry the momentum (a
+    // dual-spin spacecraft); a rigid body needs a spin.
+    if !spin_rate.is_finite() || (spin_rate == 0.0 && h_rotor == 0.0) {
+        return Err(format!(
+            "the spin rate about the spin axis is {spin_rate} rad/s and no rotor spins \
+             relative to the hub; a linearisation about steady spin needs a non-zero rate"
+        ));
+    }
     let spinning = rotors.iter().any(|r| r.rate != 0.0);
     let damped_spinning = rotors.iter().any(|r| r.rate != 0.0 && r.damping != 0.0);
     let external = sc.effectors().iter().any(|e| e.is_external());
@@ -329,6 +349,9 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     let mut y_eq = sc.rest_state(&omega, &UnitQuaternion::identity());
     for r in &rotors {
         y_eq[r.index] = r.rate;
+        for &(i, v) in &r.held {
+            y_eq[i] = v;
+        }
     }
     let n = sc.dim();
     // Linearised coordinates: ω and the effectors' dynamic states.
@@ -339,7 +362,12 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         .map(|s| s.to_string())
         .chain(effector_names)
         .collect();
-    let scale = spin_rate.abs();
+    // The rates' scale: the spin, or for a despun platform the rotors' nutation rate h/I_s.
+    let scale = if spin_rate != 0.0 {
+        spin_rate.abs()
+    } else {
+        (h_rotor / i_s).abs()
+    };
     let mut f0 = vec![0.0; n];
     sc.rhs(0.0, &y_eq, &mut f0);
     // Expected drifts are left out: along ŝ when an external torque drains the spin or a

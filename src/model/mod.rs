@@ -257,6 +257,12 @@ pub trait Effector: Debug + Send + Sync {
     fn is_external(&self) -> bool {
         false
     }
+    /// For a rotor whose motor holds its relative rate: the states (index within this
+    /// effector, value) that make the held rate an equilibrium, the rate first. `None` for
+    /// anything else.
+    fn held_rotor_states(&self) -> Option<Vec<(usize, f64)>> {
+        None
+    }
     /// Whether its field also acts on the masses other effectors move (the gravity
     /// gradient): then [`Effector::tidal_gradient`] gives it, and its work includes
     /// [`HubAcceleration::tidal_power`].
