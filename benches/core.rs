@@ -252,6 +252,65 @@ fn bench_environment_rhs(repeats: usize) {
     }
 }
 
+/// What a driven wheel costs: the gyrostat of scenarios/gyrostat.yaml with its rotor as a
+/// frictionless `wheel_damper`, then as a `wheel` coasting, held by its PI loop, and held with
+/// friction, against the rigid body, one right-hand side each.
+fn bench_wheel_rhs(repeats: usize) {
+    let load = |rotor: &str| {
+        let text = format!(
+            "name: b\nbody: {{principal: [100.0, 100.0, 60.0]}}\n\
+             initial: {{omega: [0.02, 0.0, 2.0]}}\nduration: 1\neffectors:\n{rotor}"
+        );
+        scenario::parse(Path::new("bench.yaml"), text, &Overrides::default()).expect("scenario")
+    };
+    let rigid = scenario::parse(
+        Path::new("bench.yaml"),
+        "name: b\nbody: {principal: [100.0, 100.0, 60.0]}\ninitial: {omega: [0.02, 0.0, 2.0]}\n\
+         duration: 1\n"
+            .into(),
+        &Overrides::default(),
+    )
+    .expect("scenario");
+    let calls = 20_000;
+    println!("\ndriven wheels, one right-hand-side evaluation against the rigid body:");
+    for (label, rotor) in [
+        (
+            "wheel_damper",
+            "  - wheel_damper: {inertia: 6.0, axis: [0, 0, 1], damping: 0.0, initial_rate: 50.0}\n",
+        ),
+        (
+            "wheel, free",
+            "  - wheel: {axial_inertia: 6.0, axis: [0, 0, 1], initial_rate: 50.0}\n",
+        ),
+        (
+            "wheel, held",
+            "  - wheel: {axial_inertia: 6.0, axis: [0, 0, 1], initial_rate: 50.0, \
+             motor: {speed_hold: {rate: 50.0, bandwidth: 10.0}}, max_torque: 5.0}\n",
+        ),
+        (
+            "held, friction",
+            "  - wheel: {axial_inertia: 6.0, axis: [0, 0, 1], initial_rate: 50.0, \
+             motor: {speed_hold: {rate: 50.0, bandwidth: 10.0}}, max_torque: 5.0, \
+             friction: {viscous: 1.0e-3, coulomb: 1.0e-2}}\n",
+        ),
+    ] {
+        let with = load(rotor);
+        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
+        let mut f_base = time_rhs(&rigid, calls);
+        let mut f = time_rhs(&with, calls);
+        for _ in 0..repeats {
+            base_best = base_best.min(min_time(1, &mut f_base));
+            best = best.min(min_time(1, &mut f));
+        }
+        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
+        println!(
+            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
+            ns - base_ns,
+            ns / base_ns
+        );
+    }
+}
+
 /// The orbit angle's sine and cosine, the largest single part of the gravity gradient in a
 /// circular orbit: the table-driven `polhode::orbit::sincos` against the C library's, at
 /// the angles a LEO orbit reaches in a day.
@@ -347,6 +406,7 @@ fn main() {
         return;
     }
     bench_effector_rhs(repeats);
+    bench_wheel_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(
         repeats,
