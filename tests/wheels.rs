@@ -260,3 +260,68 @@ fn bad_wheels_are_refused_with_located_errors() {
         assert!(e.starts_with("test.yaml:"), "{e}");
     }
 }
+
+/// A torque profile's steps are breakpoints: the integrators stop exactly on each, the held
+/// torque takes its new value and the method restarts on the far side, so no step straddles a
+/// jump. With the rotor on the symmetry axis of a body
+/// spinning about it, ω₃ and Ω are exactly piecewise linear (ω̇₃ = −u/(I_s − I_a),
+/// Ω̇ = u/I_a + u/(I_s − I_a)), which every Runge–Kutta or collocation step integrates exactly
+/// when it does not cross a jump: the error stays at rounding. The step profile's value is a
+/// held state updated at the stops, so with the stops turned off the torque would never
+/// change (checked: the error is then 2e-2 rad/s).
+#[test]
+fn adaptive_methods_stop_exactly_at_torque_steps() {
+    let (is, ia) = (60.0, 6.0);
+    let steps = [(1.0, 0.5), (2.5, -1.25), (4.0, 0.75), (6.2, 0.0)];
+    let table: Vec<String> = steps.iter().map(|(t, u)| format!("[{t}, {u}]")).collect();
+    for method in [
+        "{method: dopri5, rtol: 1.0e-9, atol: 1.0e-12}",
+        "{method: dop853, rtol: 1.0e-9, atol: 1.0e-12}",
+        "{method: radau5, rtol: 1.0e-9, atol: 1.0e-12}",
+    ] {
+        let yaml = format!(
+            "name: steps
+body: {{principal: [100.0, 100.0, {is}]}}
+initial: {{omega: [0.0, 0.0, 0.1]}}
+duration: 8.0
+integrator: {method}
+output: {{rate: 4}}
+effectors:
+  - wheel:
+      axial_inertia: {ia}
+      axis: [0, 0, 1]
+      motor: {{torque: {{steps: [{}]}}}}
+",
+            table.join(", ")
+        );
+        let s = load(&yaml);
+        let (out, rec) = run(&s);
+        assert_eq!(out.status, Status::Complete, "{method}");
+        // ω₃ and Ω by hand: integrate the piecewise-constant torque.
+        let exact = |t: f64| {
+            let (mut w3, mut rate, mut t0, mut u) = (0.1, 0.0, 0.0, 0.0);
+            for &(tk, uk) in &steps {
+                if tk > t {
+                    break;
+                }
+                w3 -= u / (is - ia) * (tk - t0);
+                rate += u * (1.0 / ia + 1.0 / (is - ia)) * (tk - t0);
+                (t0, u) = (tk, uk);
+            }
+            w3 -= u / (is - ia) * (t - t0);
+            rate += u * (1.0 / ia + 1.0 / (is - ia)) * (t - t0);
+            (w3, rate)
+        };
+        let mut worst: f64 = 0.0;
+        for o in &rec.samples {
+            worst = worst.max((o.omega[2] - exact(o.t).0).abs());
+        }
+        let (_, rate) = exact(8.0);
+        let rate_err = (out.final_state[7] - rate).abs();
+        assert!(worst < 1e-14, "{method}: largest ω₃ error {worst:e} rad/s");
+        assert!(
+            rate_err < 1e-13,
+            "{method}: rotor rate error {rate_err:e} rad/s"
+        );
+    }
+}

@@ -51,6 +51,17 @@ impl TorqueProfile {
             }
         }
     }
+
+    /// The first breakpoint after `t` (s), if any.
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match self {
+            TorqueProfile::Constant(_) => None,
+            TorqueProfile::Linear(points) | TorqueProfile::Steps(points) => {
+                let k = points.partition_point(|p| p.0 <= t);
+                points.get(k).map(|p| p.0)
+            }
+        }
+    }
 }
 
 /// A PI loop on the relative rate: u = K_p e + K_i z with e = Ω_cmd − Ω, saturated at
@@ -137,6 +148,9 @@ mod tests {
         assert_eq!(steps.at(2.0), -0.25);
         assert_eq!(steps.at(1e9), -0.25);
         assert_eq!(steps.breakpoints(), vec![1.0, 2.0]);
+        assert_eq!(steps.next_breakpoint(0.0), Some(1.0));
+        assert_eq!(steps.next_breakpoint(1.0), Some(2.0));
+        assert_eq!(steps.next_breakpoint(2.0), None);
         assert!(TorqueProfile::Constant(2.0).breakpoints().is_empty());
     }
 

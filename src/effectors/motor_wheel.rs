@@ -18,7 +18,7 @@
 //! States: Ω (rad/s); the PI loop's integral z (rad) in `speed_hold`; the motor's work (J);
 //! the dissipated energy (J).
 
-use super::motor::{Friction, MotorMode};
+use super::motor::{Friction, MotorMode, TorqueProfile};
 use crate::model::{
     Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum, Validity,
 };
@@ -57,9 +57,20 @@ impl MotorWheel {
         matches!(self.mode, MotorMode::SpeedHold(_))
     }
 
-    /// Index of the motor-work state (after Ω and, in `speed_hold`, z).
+    /// Whether the motor torque is a held (discrete) state: a step profile, whose value
+    /// changes only at its breakpoints, where the run stops and updates it.
+    fn holds_torque(&self) -> bool {
+        matches!(self.mode, MotorMode::Torque(TorqueProfile::Steps(_)))
+    }
+
+    /// Index of the motor-work state (after Ω and, in `speed_hold`, z, or for a step
+    /// profile the held torque).
     fn work_index(&self) -> usize {
-        if self.holds_speed() { 2 } else { 1 }
+        if self.holds_speed() || self.holds_torque() {
+            2
+        } else {
+            1
+        }
     }
 
     fn limit(&self, u: f64) -> f64 {
@@ -74,6 +85,7 @@ impl MotorWheel {
     pub fn motor_torque(&self, t: f64, x: &[f64]) -> (f64, f64) {
         match &self.mode {
             MotorMode::Free => (0.0, 0.0),
+            MotorMode::Torque(TorqueProfile::Steps(_)) => (self.limit(x[1]), x[1]),
             MotorMode::Torque(profile) => {
                 let v = profile.at(t);
                 (self.limit(v), v)
@@ -104,12 +116,18 @@ impl Effector for MotorWheel {
         if self.holds_speed() {
             names.push("rate_error_integral".into());
         }
+        if self.holds_torque() {
+            names.push("held_torque".into());
+        }
         names.extend(["motor_work".into(), "dissipated_energy".into()]);
         names
     }
     fn initial_state(&self) -> Vec<f64> {
         let mut x = vec![0.0; self.num_states()];
         x[0] = self.initial_rate;
+        if let MotorMode::Torque(profile @ TorqueProfile::Steps(_)) = &self.mode {
+            x[1] = profile.at(0.0);
+        }
         x
     }
     fn scratch_len(&self) -> usize {
@@ -141,6 +159,9 @@ impl Effector for MotorWheel {
         if let MotorMode::SpeedHold(hold) = &self.mode {
             // Back-calculation anti-windup with the tracking time K_p/K_i.
             dx[1] = (hold.rate - x[0]) + (u - v) / hold.kp;
+        }
+        if self.holds_torque() {
+            dx[1] = 0.0;
         }
         let w = self.work_index();
         dx[w] = u * x[0];
@@ -190,6 +211,18 @@ impl Effector for MotorWheel {
             x[w + 1],
             f * x[0],
         ]
+    }
+    fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        match &self.mode {
+            MotorMode::Torque(profile) => profile.next_breakpoint(t),
+            _ => None,
+        }
+    }
+    fn at_breakpoint(&self, t: f64, x: &mut [f64]) {
+        // The step profile's new value, held until the next breakpoint.
+        if let MotorMode::Torque(profile @ TorqueProfile::Steps(_)) = &self.mode {
+            x[1] = profile.at(t);
+        }
     }
     fn held_rotor_states(&self) -> Option<Vec<(usize, f64)>> {
         // At the held rate the motor supplies the friction: K_i z = f(Ω_cmd) (with K_i = 0

@@ -652,6 +652,12 @@ impl Stepper for Dop853 {
 
     /// Seventh-order interpolant of the last accepted step. Panics for a time strictly inside
     /// the step if dense output was switched off ([`Dop853::with_dense_output`]).
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+        self.y.copy_from_slice(y);
+        // The first-same-as-last stage is recomputed at the next step (the step size is kept).
+        self.first_step = true;
+    }
+
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
         // The step's ends are returned as stored.

@@ -291,6 +291,12 @@ impl Stepper for Dopri5 {
         }
     }
 
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+        self.y.copy_from_slice(y);
+        // The first-same-as-last stage is recomputed at the next step (the step size is kept).
+        self.first_step = true;
+    }
+
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
         // The step's ends are returned as stored.

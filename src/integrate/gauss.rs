@@ -180,6 +180,8 @@ pub struct Gauss {
     refresh_next: bool,
     /// Whether the starting guess extrapolates the last collocation polynomial (else zero).
     extrapolate: bool,
+    /// Set by [`Stepper::restart`]: the next starting guess is zero.
+    restarted: bool,
     /// Whether the increment is `h Σ bᵢ kᵢ` (2 stages) rather than `Σ dᵢ Zᵢ` (1 stage).
     update_from_k: bool,
     stats: Stats,
@@ -226,6 +228,7 @@ impl Gauss {
             have_jacobian: false,
             refresh_next: false,
             extrapolate: true,
+            restarted: false,
             stats: Stats::default(),
         }
     }
@@ -304,7 +307,8 @@ impl Gauss {
     /// (`Zᵢ⁰ = Σₗ (Eₗ(1 + cᵢh/h_p) − dₗ) Zₗ`, from the last step's stages, no cancellation).
     fn starting_guess(&mut self, h: f64) {
         let hp = self.t - self.t_prev;
-        if !self.extrapolate || hp == 0.0 {
+        if !self.extrapolate || hp == 0.0 || self.restarted {
+            self.restarted = false;
             self.z.fill(0.0);
             return;
         }
@@ -594,6 +598,13 @@ impl Stepper for Gauss {
         self.grid.advance(on_grid);
         self.stats.steps += 1;
         Ok(self.t)
+    }
+
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+        self.y.copy_from_slice(y);
+        // The next starting guess is zero, not the last polynomial extrapolated across the
+        // jump.
+        self.restarted = true;
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {

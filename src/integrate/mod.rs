@@ -130,6 +130,12 @@ pub trait Stepper {
     fn interpolate(&self, t: f64, out: &mut [f64]);
     /// Work counters so far.
     fn stats(&self) -> Stats;
+    /// Continues from the current time with the state `y` (the integrated one, with held
+    /// states updated at a breakpoint) and forgets what the method carries over from before
+    /// (a first-same-as-last stage, the derivative at the step's start, a starting guess
+    /// extrapolated from the last step): the next step starts afresh from `f(t, y)`. The last
+    /// step's dense output stays as it was (the left side of the breakpoint).
+    fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]);
 }
 
 /// Where an adaptive step ends; see [`adaptive_step_end`].

@@ -714,6 +714,15 @@ impl Stepper for Radau5 {
         }
     }
 
+    fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]) {
+        self.y.copy_from_slice(y);
+        // f(t, y) on the new side of the jump; no extrapolated starting values, and the
+        // first-step error filter, as at the start.
+        sys.rhs(self.t, &self.y, &mut self.f0);
+        self.stats.rhs_evaluations += 1;
+        self.first = true;
+    }
+
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
         // The step's ends are returned as stored.

@@ -137,6 +137,11 @@ impl Stepper for Rk4 {
         Ok(self.t)
     }
 
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+        self.y.copy_from_slice(y);
+        // Each step evaluates its own stages: nothing carried over.
+    }
+
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
         // The step's ends are returned as stored (also when the stages overflowed).

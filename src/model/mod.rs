@@ -257,6 +257,15 @@ pub trait Effector: Debug + Send + Sync {
     fn is_external(&self) -> bool {
         false
     }
+    /// The first time after `t` (s) at which its right-hand side is not smooth (a commanded
+    /// torque's step or kink), for the integrators to stop at; `None` when there is none.
+    fn next_breakpoint(&self, _t: f64) -> Option<f64> {
+        None
+    }
+    /// At its breakpoint `t` (s), updates its held (discrete) states `x`, which have zero
+    /// derivative between breakpoints: a step profile's value is a state, not a function of
+    /// time, so that no integration stage sees the wrong side of the jump.
+    fn at_breakpoint(&self, _t: f64, _x: &mut [f64]) {}
     /// For a rotor whose motor holds its relative rate: the states (index within this
     /// effector, value) that make the held rate an equilibrium, the rate first. `None` for
     /// anything else.
@@ -478,6 +487,24 @@ impl Spacecraft {
     /// The prescribed hub motion, if any.
     pub fn motion(&self) -> Option<&dyn HubMotion> {
         self.motion.as_deref()
+    }
+
+    /// The first breakpoint of any effector after `t` (s): where the right-hand side is not
+    /// smooth and the integrators must stop and restart ([`Effector::next_breakpoint`]).
+    pub fn next_breakpoint(&self, t: f64) -> Option<f64> {
+        self.effectors
+            .iter()
+            .filter_map(|e| e.next_breakpoint(t))
+            .min_by(f64::total_cmp)
+    }
+
+    /// Updates every effector's held states in `y` at the breakpoint `t` (s)
+    /// ([`Effector::at_breakpoint`]).
+    pub fn at_breakpoint(&self, t: f64, y: &mut [f64]) {
+        for (k, e) in self.effectors.iter().enumerate() {
+            let off = self.offsets[k];
+            e.at_breakpoint(t, &mut y[off..off + self.lens[k]]);
+        }
     }
 
     /// The effectors, in state order.

@@ -124,6 +124,9 @@ impl Stepper for AnyStepper {
     fn stats(&self) -> Stats {
         each!(self, s => s.stats())
     }
+    fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]) {
+        each!(self, s => s.restart(sys, y))
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -268,6 +271,9 @@ impl LieStepper {
 }
 
 impl Stepper for LieStepper {
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
+        // Rigid bodies only (no effector, so no breakpoint and no held state).
+    }
     fn t(&self) -> f64 {
         self.t
     }
@@ -523,6 +529,9 @@ struct RkScratch {
 }
 
 impl Stepper for SplittingStepper {
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
+        // Rigid bodies only (no effector, so no breakpoint and no held state).
+    }
     fn t(&self) -> f64 {
         self.t
     }
@@ -725,6 +734,9 @@ impl ExactStepper {
 }
 
 impl Stepper for ExactStepper {
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
+        // Rigid bodies only (no effector, so no breakpoint and no held state).
+    }
     fn t(&self) -> f64 {
         self.t
     }

@@ -285,9 +285,15 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
     }
     while stepper.t() < t_end {
         let t0 = stepper.t();
+        let stop = next_stop(sc, t0, t_end);
         stepper
-            .step(sc, t_end)
+            .step(sc, stop)
             .map_err(|e| diagnose(&e.to_string(), t0, stepper.y(), scenario))?;
+        if stepper.t() == stop && stop < t_end {
+            let mut y = stepper.y().to_vec();
+            sc.at_breakpoint(stop, &mut y);
+            stepper.restart(sc, &y);
+        }
         if !stepper.y().iter().all(|v| v.is_finite()) {
             let what = format!(
                 "the state became non-finite in the step from t = {} to t = {}",
@@ -326,6 +332,16 @@ pub const MAX_STEPS_TO_GO: f64 = 1e11;
 
 /// Steps over which the average step size is measured for [`MAX_STEPS_TO_GO`].
 const COLLAPSE_WINDOW: u64 = 10_000;
+
+/// Where the next step must end at the latest: the run's end, or the first breakpoint of an
+/// effector after `t` (a commanded torque's step), where the right-hand side jumps and the
+/// integrator stops exactly and restarts ([`Stepper::restart`]).
+fn next_stop(sc: &crate::model::Spacecraft, t: f64, t_end: f64) -> f64 {
+    match sc.next_breakpoint(t) {
+        Some(b) if b < t_end => b,
+        _ => t_end,
+    }
+}
 
 /// How often (in steps) the interrupt flag and the wall clock are looked at.
 const POLL_STEPS: u64 = 64;
@@ -421,6 +437,8 @@ fn drive<M: Stepper>(
     let mut last_poll = Instant::now();
     // Scenes without a prescribed motion conserve the energy balance.
     let passive = sc.motion().is_none();
+    // Set when the last step ended on an effector's breakpoint.
+    let mut at_breakpoint = false;
     while status.is_none() && stepper.t() < t_end {
         if stepper.stats().steps.is_multiple_of(POLL_STEPS) {
             if ctl.interrupt.load(Ordering::Relaxed) {
@@ -435,13 +453,23 @@ fn drive<M: Stepper>(
             }
         }
         let t0 = stepper.t();
-        if let Err(e) = stepper.step(sc, t_end) {
+        if at_breakpoint {
+            // Held states take their new values; the next step starts afresh on the far side.
+            buf.copy_from_slice(stepper.y());
+            sc.at_breakpoint(t0, &mut buf);
+            stepper.restart(sc, &buf);
+        }
+        let stop = next_stop(sc, t0, t_end);
+        if let Err(e) = stepper.step(sc, stop) {
             status = Some(Status::Failed {
                 diagnosis: diagnose(&e.to_string(), t0, stepper.y(), scenario),
             });
             break;
         }
         let t1 = stepper.t();
+        // A breakpoint reached: restart before the next step (this step's samples and events
+        // are read from its dense output first, on the breakpoint's near side).
+        at_breakpoint = t1 == stop && stop < t_end;
         if !stepper.y().iter().all(|v| v.is_finite()) {
             // Report the last finite state: the start of the failed step.
             let t_good = stepper.t_prev();
