@@ -162,14 +162,7 @@ fn bench_effector_rhs(repeats: usize) {
             &Overrides::default(),
         )
         .expect("scenario");
-        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
-        let mut f_base = time_rhs(&rigid, calls);
-        let mut f = time_rhs(&s, calls);
-        for _ in 0..repeats {
-            base_best = base_best.min(min_time(1, &mut f_base));
-            best = best.min(min_time(1, &mut f));
-        }
-        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
+        let (base_ns, ns) = rhs_times(&rigid, &s, calls, repeats);
         println!(
             "  {file:<28} {:>3} states  {ns:>9.1} ns  rigid {base_ns:>6.1} ns  ratio {:>7.1}",
             s.spacecraft.dim(),
@@ -192,6 +185,40 @@ fn time_rhs(s: &scenario::Scenario, calls: usize) -> impl FnMut() + '_ {
             black_box(&dy);
         }
     }
+}
+
+/// One right-hand side of `rigid` and of `with` (ns), each the best of `repeats` runs of
+/// `calls` evaluations, interleaved.
+fn rhs_times(
+    rigid: &scenario::Scenario,
+    with: &scenario::Scenario,
+    calls: usize,
+    repeats: usize,
+) -> (f64, f64) {
+    let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
+    let mut f_base = time_rhs(rigid, calls);
+    let mut f = time_rhs(with, calls);
+    for _ in 0..repeats {
+        base_best = base_best.min(min_time(1, &mut f_base));
+        best = best.min(min_time(1, &mut f));
+    }
+    (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9)
+}
+
+/// Prints what `with` adds to `rigid`'s right-hand side, and the ratio.
+fn print_added(
+    label: &str,
+    rigid: &scenario::Scenario,
+    with: &scenario::Scenario,
+    calls: usize,
+    repeats: usize,
+) {
+    let (base_ns, ns) = rhs_times(rigid, with, calls, repeats);
+    println!(
+        "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
+        ns - base_ns,
+        ns / base_ns
+    );
 }
 
 /// What the gravity gradient adds to a rigid body's right-hand side, as a ratio in one run:
@@ -236,19 +263,7 @@ fn bench_environment_rhs(repeats: usize) {
         ),
     ] {
         let with = load(yaml(orbit, effectors));
-        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
-        let mut f_base = time_rhs(&rigid, calls);
-        let mut f = time_rhs(&with, calls);
-        for _ in 0..repeats {
-            base_best = base_best.min(min_time(1, &mut f_base));
-            best = best.min(min_time(1, &mut f));
-        }
-        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
-        println!(
-            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
-            ns - base_ns,
-            ns / base_ns
-        );
+        print_added(label, &rigid, &with, calls, repeats);
     }
 }
 
@@ -295,19 +310,7 @@ fn bench_wheel_rhs(repeats: usize) {
         ),
     ] {
         let with = load(rotor);
-        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
-        let mut f_base = time_rhs(&rigid, calls);
-        let mut f = time_rhs(&with, calls);
-        for _ in 0..repeats {
-            base_best = base_best.min(min_time(1, &mut f_base));
-            best = best.min(min_time(1, &mut f));
-        }
-        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
-        println!(
-            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
-            ns - base_ns,
-            ns / base_ns
-        );
+        print_added(label, &rigid, &with, calls, repeats);
     }
 }
 
@@ -379,19 +382,7 @@ fn bench_drag_rhs(repeats: usize) {
         ),
     ] {
         let with = load(yaml(shape, drag));
-        let (mut base_best, mut best) = (f64::INFINITY, f64::INFINITY);
-        let mut f_base = time_rhs(&rigid, calls);
-        let mut f = time_rhs(&with, calls);
-        for _ in 0..repeats {
-            base_best = base_best.min(min_time(1, &mut f_base));
-            best = best.min(min_time(1, &mut f));
-        }
-        let (base_ns, ns) = (base_best / calls as f64 * 1e9, best / calls as f64 * 1e9);
-        println!(
-            "  {label:<16} {ns:>7.1} ns  rigid {base_ns:>6.1} ns  added {:>6.1} ns  ratio {:>5.2}",
-            ns - base_ns,
-            ns / base_ns
-        );
+        print_added(label, &rigid, &with, calls, repeats);
     }
 }
 

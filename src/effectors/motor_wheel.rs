@@ -19,6 +19,7 @@
 //! the dissipated energy (J).
 
 use super::motor::{Friction, MotorMode, TorqueProfile};
+use super::wheel::{rotor_speed_report, rotor_speed_validity};
 use crate::model::{
     Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum, Validity,
 };
@@ -48,9 +49,6 @@ pub struct MotorWheel {
     /// Largest relative speed |Ω| the wheel is rated for (rad/s); `None`: unrated.
     pub max_speed: Option<f64>,
 }
-
-/// Fraction of the rated speed past which the wheel warns.
-pub const SPEED_WARN: f64 = 0.9;
 
 impl MotorWheel {
     fn holds_speed(&self) -> bool {
@@ -236,21 +234,11 @@ impl Effector for MotorWheel {
         }
     }
     fn validity(&self, x: &[f64]) -> Option<Validity> {
-        self.max_speed.map(|max| Validity {
-            value: x[0].abs(),
-            warn: SPEED_WARN * max,
-            limit: max,
-        })
+        rotor_speed_validity(self.max_speed, x[0])
     }
     fn validity_report(&self, x: &[f64]) -> (String, String) {
         (
-            format!(
-                "its rotor turns at {:.6e} rad/s relative to the hub, against its rated {} \
-                 rad/s (warning at {}%)",
-                x[0].abs(),
-                self.max_speed.unwrap_or(f64::INFINITY),
-                SPEED_WARN * 100.0
-            ),
+            rotor_speed_report(self.max_speed, x[0]),
             "a lower commanded rate or torque, a wheel with more inertia, or momentum \
              unloading"
                 .into(),

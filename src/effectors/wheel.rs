@@ -37,6 +37,27 @@ pub struct WheelDamper {
 /// Fraction of the rated speed past which the wheel warns.
 pub const SPEED_WARN: f64 = 0.9;
 
+/// Where a rotor's relative rate `rate` (rad/s) stands against its rated `max_speed`
+/// ([`Effector::validity`] of `wheel_damper` and `wheel`).
+pub fn rotor_speed_validity(max_speed: Option<f64>, rate: f64) -> Option<Validity> {
+    max_speed.map(|max| Validity {
+        value: rate.abs(),
+        warn: SPEED_WARN * max,
+        limit: max,
+    })
+}
+
+/// The rotor's speed in words against its rating, for warnings and diagnoses.
+pub fn rotor_speed_report(max_speed: Option<f64>, rate: f64) -> String {
+    format!(
+        "its rotor turns at {:.6e} rad/s relative to the hub, against its rated {} rad/s \
+         (warning at {}%)",
+        rate.abs(),
+        max_speed.unwrap_or(f64::INFINITY),
+        SPEED_WARN * 100.0
+    )
+}
+
 impl Effector for WheelDamper {
     fn name(&self) -> &str {
         &self.name
@@ -100,21 +121,11 @@ impl Effector for WheelDamper {
         vec![x[0], x[1], self.damping * x[0] * x[0]]
     }
     fn validity(&self, x: &[f64]) -> Option<Validity> {
-        self.max_speed.map(|max| Validity {
-            value: x[0].abs(),
-            warn: SPEED_WARN * max,
-            limit: max,
-        })
+        rotor_speed_validity(self.max_speed, x[0])
     }
     fn validity_report(&self, x: &[f64]) -> (String, String) {
         (
-            format!(
-                "its rotor turns at {:.6e} rad/s relative to the hub, against its rated {} \
-                 rad/s (warning at {}%)",
-                x[0].abs(),
-                self.max_speed.unwrap_or(f64::INFINITY),
-                SPEED_WARN * 100.0
-            ),
+            rotor_speed_report(self.max_speed, x[0]),
             "a rotor with more inertia or less initial rate, or a higher rating if the \
              hardware has it"
                 .into(),
