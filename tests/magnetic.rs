@@ -188,27 +188,10 @@ effectors:
     let s = load(yaml);
     let (out, rec) = run(&s);
     assert_eq!(out.status, Status::Complete);
-    let (e0, t0) = (
-        rec.samples[0].energy_balance(),
-        rec.samples[0].kinetic_energy,
-    );
-    let mut worst: f64 = 0.0;
-    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
-    for (e, t) in rec
-        .samples
-        .iter()
-        .map(|o| (o.energy_balance(), o.kinetic_energy))
-    {
-        worst = worst.max((e - e0).abs() / t0);
-        lo = lo.min(t);
-        hi = hi.max(t);
-    }
-    eprintln!(
-        "T - W drift {worst:e} of T0, T spread {:e} of T0",
-        (hi - lo) / t0
-    );
+    let (worst, spread) = common::balance_drift_and_spread(&rec.samples);
+    eprintln!("T - W drift {worst:e} of T0, T spread {:e} of T0", spread);
     assert!(worst < 1e-9, "energy balance drift {worst:e} (relative)");
-    assert!((hi - lo) / t0 > 1e-3, "T spread {:e}", (hi - lo) / t0);
+    assert!(spread > 1e-3, "T spread {:e}", spread);
 }
 
 #[test]

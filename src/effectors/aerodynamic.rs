@@ -140,6 +140,17 @@ impl Aerodynamic {
     }
 }
 
+/// The telemetry of both drag models (units in `log::units`).
+const TELEMETRY: [&str; 8] = [
+    "torque_x", "torque_y", "torque_z", "density", "wind_x", "wind_y", "wind_z", "work",
+];
+
+/// One telemetry sample in the order of [`TELEMETRY`]: the torque (N m), the density
+/// (kg/m³), the relative wind in body axes (m/s) and the work done so far (J).
+fn telemetry_row(tau: &Vector3<f64>, rho: f64, wind: &Vector3<f64>, work: f64) -> Vec<f64> {
+    vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
+}
+
 impl EnvironmentTorque for Aerodynamic {
     fn name(&self) -> &str {
         &self.name
@@ -151,14 +162,12 @@ impl EnvironmentTorque for Aerodynamic {
         self.torque_at(t, q)
     }
     fn telemetry_names(&self) -> Vec<String> {
-        names(&[
-            "torque_x", "torque_y", "torque_z", "density", "wind_x", "wind_y", "wind_z", "work",
-        ])
+        names(&TELEMETRY)
     }
     fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
         let (rho, wind) = self.density_and_wind(t, q);
         let tau = self.center_of_pressure.cross(&self.force(rho, &wind));
-        vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
+        telemetry_row(&tau, rho, &wind, work)
     }
 }
 
@@ -225,14 +234,12 @@ impl EnvironmentTorque for ShapeAerodynamic {
         self.torque_at(t, q)
     }
     fn telemetry_names(&self) -> Vec<String> {
-        names(&[
-            "torque_x", "torque_y", "torque_z", "density", "wind_x", "wind_y", "wind_z", "work",
-        ])
+        names(&TELEMETRY)
     }
     fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
         let (rho, wind) = self.density_and_wind(t, q);
         let tau = self.force_and_torque(rho, &wind).1;
-        vec![tau[0], tau[1], tau[2], rho, wind[0], wind[1], wind[2], work]
+        telemetry_row(&tau, rho, &wind, work)
     }
 }
 

@@ -66,3 +66,17 @@ pub fn rigid_yaml(
         principal[0], principal[1], principal[2], omega[0], omega[1], omega[2]
     )
 }
+
+/// The energy balance's largest change from its first sample, and the kinetic energy's spread
+/// (largest minus smallest), both as fractions of the first sample's kinetic energy T₀.
+pub fn balance_drift_and_spread(samples: &[Observation]) -> (f64, f64) {
+    let (e0, t0) = (samples[0].energy_balance(), samples[0].kinetic_energy);
+    let mut worst: f64 = 0.0;
+    let (mut lo, mut hi) = (f64::MAX, f64::MIN);
+    for o in samples {
+        worst = worst.max((o.energy_balance() - e0).abs() / t0);
+        lo = lo.min(o.kinetic_energy);
+        hi = hi.max(o.kinetic_energy);
+    }
+    (worst, (hi - lo) / t0)
+}
