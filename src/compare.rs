@@ -120,6 +120,7 @@ pub fn short_title(c: &Condition, with_once: bool) -> String {
         Quantity::AngleToPrincipalDeg(i) => (format!("∠ω,e{}", i + 1), "°"),
         Quantity::Omega(i) => (format!("ω_{}", ["x", "y", "z"][i.min(2)]), ""),
         Quantity::KineticEnergy => ("T".to_string(), " J"),
+        Quantity::RateDegS => ("|ω|".to_string(), "°/s"),
     };
     let op = if c.above { ">" } else { "<" };
     let mut text = format!("{symbol} {op} {}{unit}", c.threshold);

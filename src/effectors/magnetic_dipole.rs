@@ -20,6 +20,15 @@ use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::Vector3;
 use std::sync::Arc;
 
+/// The geomagnetic field (T, body axes) at the position of `orbit` at time `t` (s), for the
+/// integrated attitude `q` (w, x, y, z; body → inertial; normalised here).
+#[inline]
+pub fn field_body(orbit: &Orbit, field: &GeomagneticField, t: f64, q: &[f64]) -> Vector3<f64> {
+    let (r_hat, radius) = orbit.direction(t);
+    let b_n = field.field_eci(t, &r_hat, radius);
+    to_body(q, &b_n)
+}
+
 /// A constant magnetic dipole moment on the hub in the Earth's field.
 #[derive(Debug, Clone)]
 pub struct MagneticDipole {
@@ -38,9 +47,7 @@ impl MagneticDipole {
     /// body → inertial; normalised here).
     #[inline]
     pub fn field_body(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        let (r_hat, radius) = self.orbit.direction(t);
-        let b_n = self.field.field_eci(t, &r_hat, radius);
-        to_body(q, &b_n)
+        field_body(&self.orbit, &self.field, t, q)
     }
 
     /// The torque m × B (N m, body axes) at `t` for attitude `q`.

@@ -8,6 +8,8 @@
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
+//! - [`Magnetorquer`]: coils commanded by a discrete B-dot detumbling law, saturated per axis.
+//! - [`MotorWheel`]: a driven rotor (free, torque profile, speed hold, or rate damping).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
 //! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure,
 //!   and [`aerodynamic::ShapeAerodynamic`] on the facets of the body's shape.
@@ -17,11 +19,13 @@
 
 pub mod aerodynamic;
 pub mod beam;
+pub mod clock;
 pub mod energy_sink;
 pub mod environment;
 pub mod gravity_gradient;
 pub mod hinged_rod;
 pub mod magnetic_dipole;
+pub mod magnetorquer;
 pub mod modal;
 pub mod motion;
 pub mod motor;
@@ -37,6 +41,7 @@ pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};
 pub use magnetic_dipole::MagneticDipole;
+pub use magnetorquer::Magnetorquer;
 pub use modal::ModalBeam;
 pub use motion::SpinUp;
 pub use motor_wheel::MotorWheel;

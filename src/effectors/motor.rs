@@ -91,6 +91,19 @@ impl SpeedHold {
     }
 }
 
+/// This wheel's share of a discrete rate-damping law for the hub, sampled at the clock's
+/// ticks and held: the assembly's wheels with axes â_j (the columns of A) command motor
+/// torques u = K A⁺ ω, so that the hub takes −A u = −K P ω, with P = A A⁺ the projection on
+/// the axes' span (the whole of −K ω when they span three dimensions). This wheel's row of
+/// K A⁺ is `gains`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RateDamping {
+    /// This wheel's row of K A⁺ (N m s): its command is u = `gains`·ω.
+    pub gains: nalgebra::Vector3<f64>,
+    /// When the controller samples ω.
+    pub clock: super::clock::SampleClock,
+}
+
 /// How the motor drives the rotor.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MotorMode {
@@ -100,6 +113,8 @@ pub enum MotorMode {
     Torque(TorqueProfile),
     /// A PI loop holding the relative rate.
     SpeedHold(SpeedHold),
+    /// Its share of a discrete rate-damping law for the hub (zero-order hold).
+    RateDamping(RateDamping),
 }
 
 /// Bearing friction on the rotor: viscous plus Coulomb, the Coulomb part smoothed near zero

@@ -15,8 +15,9 @@
 //! W = ∫ u Ω dt enters the energy balance as work done on the spacecraft, and the friction's
 //! ∫ f Ω dt ≥ 0 as dissipated energy.
 //!
-//! States: Ω (rad/s); the PI loop's integral z (rad) in `speed_hold`; the motor's work (J);
-//! the dissipated energy (J).
+//! States: Ω (rad/s); the PI loop's integral z (rad) in `speed_hold`, or the held torque
+//! command (N m) of a step profile or of rate damping; the motor's work (J); the dissipated
+//! energy (J).
 
 use super::motor::{Friction, MotorMode, TorqueProfile};
 use super::wheel::{rotor_speed_report, rotor_speed_validity};
@@ -55,10 +56,14 @@ impl MotorWheel {
         matches!(self.mode, MotorMode::SpeedHold(_))
     }
 
-    /// Whether the motor torque is a held (discrete) state: a step profile, whose value
-    /// changes only at its breakpoints, where the run stops and updates it.
+    /// Whether the motor torque is a held (discrete) state: a step profile, or a sampled
+    /// controller's command, whose value changes only at its breakpoints, where the run stops
+    /// and updates it.
     fn holds_torque(&self) -> bool {
-        matches!(self.mode, MotorMode::Torque(TorqueProfile::Steps(_)))
+        matches!(
+            self.mode,
+            MotorMode::Torque(TorqueProfile::Steps(_)) | MotorMode::RateDamping(_)
+        )
     }
 
     /// Index of the motor-work state (after Ω and, in `speed_hold`, z, or for a step
@@ -83,7 +88,9 @@ impl MotorWheel {
     pub fn motor_torque(&self, t: f64, x: &[f64]) -> (f64, f64) {
         match &self.mode {
             MotorMode::Free => (0.0, 0.0),
-            MotorMode::Torque(TorqueProfile::Steps(_)) => (self.limit(x[1]), x[1]),
+            MotorMode::Torque(TorqueProfile::Steps(_)) | MotorMode::RateDamping(_) => {
+                (self.limit(x[1]), x[1])
+            }
             MotorMode::Torque(profile) => {
                 let v = profile.at(t);
                 (self.limit(v), v)
@@ -213,13 +220,17 @@ impl Effector for MotorWheel {
     fn next_breakpoint(&self, t: f64) -> Option<f64> {
         match &self.mode {
             MotorMode::Torque(profile) => profile.next_breakpoint(t),
+            MotorMode::RateDamping(law) => Some(law.clock.next_tick(t)),
             _ => None,
         }
     }
-    fn at_breakpoint(&self, t: f64, x: &mut [f64]) {
+    fn at_breakpoint(&self, hub: &HubState, x: &mut [f64]) {
         // The step profile's new value, held until the next breakpoint.
-        if let MotorMode::Torque(profile @ TorqueProfile::Steps(_)) = &self.mode {
-            x[1] = profile.at(t);
+        match &self.mode {
+            MotorMode::Torque(profile @ TorqueProfile::Steps(_)) => x[1] = profile.at(hub.t),
+            // The controller's tick: sample ω, hold the command until the next.
+            MotorMode::RateDamping(law) => x[1] = law.gains.dot(&hub.omega),
+            _ => {}
         }
     }
     fn held_rotor_states(&self) -> Option<Vec<(usize, f64)>> {

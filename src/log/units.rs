@@ -293,6 +293,36 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("magnetic_dipole", "torque_z") => {
             return fixed("Magnetic torque m × B on the hub, body z", "N m");
         }
+        ("magnetorquer", "dipole_x") => {
+            return fixed("Commanded coil dipole, held between ticks, body x", "A m^2");
+        }
+        ("magnetorquer", "dipole_y") => {
+            return fixed("Commanded coil dipole, held between ticks, body y", "A m^2");
+        }
+        ("magnetorquer", "dipole_z") => {
+            return fixed("Commanded coil dipole, held between ticks, body z", "A m^2");
+        }
+        ("magnetorquer", "torque_x") => {
+            return fixed("Magnetic torque m × B on the hub, body x", "N m");
+        }
+        ("magnetorquer", "torque_y") => {
+            return fixed("Magnetic torque m × B on the hub, body y", "N m");
+        }
+        ("magnetorquer", "torque_z") => {
+            return fixed("Magnetic torque m × B on the hub, body z", "N m");
+        }
+        ("magnetorquer", "b_x") => return fixed("Geomagnetic field, body x", "T"),
+        ("magnetorquer", "b_y") => return fixed("Geomagnetic field, body y", "T"),
+        ("magnetorquer", "b_z") => return fixed("Geomagnetic field, body z", "T"),
+        ("magnetorquer", "samples") => {
+            return fixed(
+                "Field samples the controller has taken (ticks)",
+                DIMENSIONLESS,
+            );
+        }
+        ("magnetorquer", "work") => {
+            return fixed("Work done by the coils' torque since the start", "J");
+        }
         ("magnetic_dipole", "b_x") => return fixed("Geomagnetic field, body x", "T"),
         ("magnetic_dipole", "b_y") => return fixed("Geomagnetic field, body y", "T"),
         ("magnetic_dipole", "b_z") => return fixed("Geomagnetic field, body z", "T"),

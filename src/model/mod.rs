@@ -262,10 +262,12 @@ pub trait Effector: Debug + Send + Sync {
     fn next_breakpoint(&self, _t: f64) -> Option<f64> {
         None
     }
-    /// At its breakpoint `t` (s), updates its held (discrete) states `x`, which have zero
+    /// At its breakpoint `hub.t` (s), updates its held (discrete) states `x`, which have zero
     /// derivative between breakpoints: a step profile's value is a state, not a function of
-    /// time, so that no integration stage sees the wrong side of the jump.
-    fn at_breakpoint(&self, _t: f64, _x: &mut [f64]) {}
+    /// time, so that no integration stage sees the wrong side of the jump. A discrete
+    /// controller samples the hub state here (its tick) and holds its command. Also called
+    /// once at t = 0 by [`Spacecraft::initial_state`]: a controller's first tick.
+    fn at_breakpoint(&self, _hub: &HubState, _x: &mut [f64]) {}
     /// For a rotor whose motor holds its relative rate: the states (index within this
     /// effector, value) that make the held rate an equilibrium, the rate first. `None` for
     /// anything else.
@@ -498,12 +500,18 @@ impl Spacecraft {
             .min_by(f64::total_cmp)
     }
 
-    /// Updates every effector's held states in `y` at the breakpoint `t` (s)
-    /// ([`Effector::at_breakpoint`]).
+    /// Updates every effector's held states in `y` at the breakpoint `t` (s), where each
+    /// samples the hub state in `y` ([`Effector::at_breakpoint`]).
     pub fn at_breakpoint(&self, t: f64, y: &mut [f64]) {
+        let (hub_part, effector_part) = y.split_at_mut(HUB_STATES);
+        let hub = HubState {
+            t,
+            omega: Vector3::new(hub_part[0], hub_part[1], hub_part[2]),
+            attitude: &hub_part[3..7],
+        };
         for (k, e) in self.effectors.iter().enumerate() {
-            let off = self.offsets[k];
-            e.at_breakpoint(t, &mut y[off..off + self.lens[k]]);
+            let off = self.offsets[k] - HUB_STATES;
+            e.at_breakpoint(&hub, &mut effector_part[off..off + self.lens[k]]);
         }
     }
 
@@ -531,6 +539,8 @@ impl Spacecraft {
         for e in &self.effectors {
             y.extend(e.initial_state());
         }
+        // Discrete controllers take their first sample at t = 0.
+        self.at_breakpoint(0.0, &mut y);
         y
     }
 

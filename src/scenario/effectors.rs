@@ -15,8 +15,10 @@ use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::Path;
 
+mod magnetorquer;
 mod wheel;
 
+use magnetorquer::MagnetorquerSpec;
 use wheel::MotorWheelSpec;
 
 /// One entry of `effectors:`.
@@ -41,6 +43,8 @@ pub enum EffectorSpec {
     GravityGradient(GravityGradientSpec),
     /// A constant magnetic dipole moment in the Earth's field (needs `orbit:`).
     MagneticDipole(MagneticDipoleSpec),
+    /// Magnetorquer coils under B-dot control (needs `orbit:`).
+    Magnetorquer(Box<MagnetorquerSpec>),
     /// Solar radiation pressure on a flat plate (needs `orbit:`).
     SolarPressure(SolarPressureSpec),
     /// Drag on a constant projected area with a fixed centre of pressure, or on the facets of
@@ -549,6 +553,8 @@ pub(super) struct Context<'a> {
     /// (None for the default).
     pub epoch_unix_ns: i64,
     pub epoch_loc: Option<(u32, u32)>,
+    /// The run's duration (s), which bounds the ticks a discrete controller may take.
+    pub duration: f64,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -557,6 +563,8 @@ pub(super) fn build(
     specs: &[Spanned<EffectorSpec>],
 ) -> Result<Vec<Box<dyn Effector>>, ScenarioError> {
     let mut out: Vec<Box<dyn Effector>> = Vec::new();
+    let rate_damping =
+        std::cell::RefCell::new(wheel::rate_damping_laws(cx.path, specs, cx.duration)?);
     for (i, spanned) in specs.iter().enumerate() {
         let spec = &spanned.value;
         // Where the list item starts, for errors about the item as a whole.
@@ -571,6 +579,7 @@ pub(super) fn build(
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
+            EffectorSpec::Magnetorquer(_) => "magnetorquer",
             EffectorSpec::SolarPressure(_) => "solar_pressure",
             EffectorSpec::Aerodynamic(_) => "aerodynamic",
         };
@@ -596,8 +605,15 @@ pub(super) fn build(
                     cx.path,
                     item,
                     ck.prefix.clone(),
-                    "an environmental torque needs the spacecraft's orbit: add an `orbit:` \
-                     block (semi_major_axis_km or perigee/apogee altitudes, inclination_deg, …)",
+                    format!(
+                        "{} needs the spacecraft's orbit: add an `orbit:` block \
+                         (semi_major_axis_km or perigee/apogee altitudes, inclination_deg, …)",
+                        if kind == "magnetorquer" {
+                            "a magnetorquer acts in the Earth's magnetic field, so it"
+                        } else {
+                            "an environmental torque"
+                        }
+                    ),
                 )
             })
         };
@@ -624,32 +640,25 @@ pub(super) fn build(
                         ),
                     ));
                 }
-                let field = crate::orbit::GeomagneticField::new(cx.epoch_unix_ns);
-                let year = field.year(0.0);
-                use crate::orbit::magnetic::{FIRST_YEAR, LAST_YEAR};
-                if !(FIRST_YEAR..=LAST_YEAR).contains(&year) {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        cx.epoch_loc.or(item),
-                        "epoch",
-                        format!(
-                            "the magnetic field model (IGRF-14 dipole) covers {FIRST_YEAR} to \
-                             {LAST_YEAR}, and the epoch is {year:.2}{}: choose an epoch in \
-                             that range",
-                            if cx.epoch_loc.is_none() {
-                                " (the default)"
-                            } else {
-                                ""
-                            }
-                        ),
-                    ));
-                }
+                let field = geomagnetic_field(cx, item)?;
                 out.push(Box::new(crate::effectors::MagneticDipole {
                     name: name_of(&m.name),
                     orbit: orbit.clone(),
                     field,
                     moment: v,
                 }));
+            }
+            EffectorSpec::Magnetorquer(m) => {
+                let orbit = needs_orbit()?;
+                let field = geomagnetic_field(cx, item)?;
+                out.push(Box::new(magnetorquer::build(
+                    &ck,
+                    cx,
+                    m,
+                    name_of(&m.name),
+                    orbit,
+                    field,
+                )?));
             }
             EffectorSpec::SolarPressure(sp) => {
                 let orbit = &needs_orbit()?;
@@ -935,7 +944,15 @@ pub(super) fn build(
                 )));
             }
             EffectorSpec::Wheel(w) => {
-                wheel::build(&ck, w, name_of(&w.name), cx.shift, cx.hub, &mut out)?;
+                wheel::build(
+                    &ck,
+                    w,
+                    name_of(&w.name),
+                    cx.shift,
+                    cx.hub,
+                    &rate_damping,
+                    &mut out,
+                )?;
             }
             EffectorSpec::WheelDamper(w) => {
                 out.push(Box::new(WheelDamper {
@@ -1180,6 +1197,33 @@ fn check_copies_on_body(
         }
     }
     Ok(())
+}
+
+/// The geomagnetic field from the scenario epoch, which must lie in the field model's years.
+fn geomagnetic_field(
+    cx: &Context,
+    item: Option<(u32, u32)>,
+) -> Result<crate::orbit::GeomagneticField, ScenarioError> {
+    let field = crate::orbit::GeomagneticField::new(cx.epoch_unix_ns);
+    let year = field.year(0.0);
+    use crate::orbit::magnetic::{FIRST_YEAR, LAST_YEAR};
+    if !(FIRST_YEAR..=LAST_YEAR).contains(&year) {
+        return Err(ScenarioError::at(
+            cx.path,
+            cx.epoch_loc.or(item),
+            "epoch",
+            format!(
+                "the magnetic field model (IGRF-14 dipole) covers {FIRST_YEAR} to {LAST_YEAR}, \
+                 and the epoch is {year:.2}{}: choose an epoch in that range",
+                if cx.epoch_loc.is_none() {
+                    " (the default)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok(field)
 }
 
 fn copy_name(base: &str, k: usize, count: usize) -> String {

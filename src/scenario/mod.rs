@@ -324,6 +324,8 @@ pub enum ConditionSpec {
     OmegaZ(ThresholdSpec),
     /// Rotational kinetic energy (J).
     KineticEnergy(ThresholdSpec),
+    /// The body's rate |ω| (deg/s): a detumbling's progress.
+    RateDegS(ThresholdSpec),
 }
 
 /// `{above: X}` or `{below: X}`: the condition holds while the quantity is above (below) X;
@@ -357,6 +359,8 @@ pub enum Quantity {
     Omega(usize),
     /// Kinetic energy (J).
     KineticEnergy,
+    /// The body's rate |ω| (deg/s).
+    RateDegS,
 }
 
 impl Quantity {
@@ -371,6 +375,7 @@ impl Quantity {
             Quantity::Omega(1) => "omega_y",
             Quantity::Omega(_) => "omega_z",
             Quantity::KineticEnergy => "kinetic_energy",
+            Quantity::RateDegS => "rate_deg_s",
         }
     }
 
@@ -381,6 +386,7 @@ impl Quantity {
             Quantity::AngleToPrincipalDeg(i) => o.angles_to_principal[i].to_degrees(),
             Quantity::Omega(i) => o.omega[i],
             Quantity::KineticEnergy => o.kinetic_energy,
+            Quantity::RateDegS => o.omega.norm().to_degrees(),
         }
     }
 }
@@ -1699,6 +1705,7 @@ impl ScenarioFile {
             orbit: orbit.clone(),
             epoch_unix_ns,
             epoch_loc: loc_of(&self.epoch),
+            duration,
         };
         let mut built = effectors::build(&cx, &self.effectors)?;
         let mut warnings = cx.notes.into_inner();
@@ -1730,6 +1737,7 @@ impl ScenarioFile {
                         orbit: orbit.clone(),
                         epoch_unix_ns,
                         epoch_loc: loc_of(&self.epoch),
+                        duration,
                     };
                     built = effectors::build(&cx, &self.effectors)?;
                     warnings = cx.notes.into_inner();
@@ -2150,6 +2158,7 @@ fn conditions(
                 ConditionSpec::OmegaY(t) => (Quantity::Omega(1), t),
                 ConditionSpec::OmegaZ(t) => (Quantity::Omega(2), t),
                 ConditionSpec::KineticEnergy(t) => (Quantity::KineticEnergy, t),
+                ConditionSpec::RateDegS(t) => (Quantity::RateDegS, t),
             };
             let field = format!("{field}[{i}].{}", quantity.key());
             let (threshold, above) = match (th.above, th.below) {

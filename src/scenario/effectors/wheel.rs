@@ -6,14 +6,16 @@
 //!     axial_inertia: 0.02          # kg m², part of body.principal/inertia as if locked
 //!     transverse_inertia: 0.011    # kg m², optional: checked (I_a ≤ 2 I_t)
 //!     axis: [0, 0, 1]
-//!     motor: {speed_hold: {rate: 200.0, bandwidth: 5.0}}   # or free, or {torque: {…}}
+//!     motor: {speed_hold: {rate: 200.0, bandwidth: 5.0}}   # or free, {torque: {…}},
+//!                                  # or {rate_damping: {gain: 0.05, sample_rate: 10}}
 //!     max_torque: 0.1              # N m
 //!     friction: {viscous: 1.0e-6, coulomb: 1.0e-4, smoothing_speed: 0.1}
 //!     copies: {count: 4, about: [0, 0, 1]}
 //! ```
 
-use super::{Check, CopiesSpec, ScenarioError, copy_name};
-use crate::effectors::motor::{Friction, MotorMode, SpeedHold, TorqueProfile};
+use super::{Check, CopiesSpec, EffectorSpec, ScenarioError, copy_name};
+use crate::effectors::clock::SampleClock;
+use crate::effectors::motor::{Friction, MotorMode, RateDamping, SpeedHold, TorqueProfile};
 use crate::effectors::motor_wheel::MotorWheel;
 use crate::model::{Effector, RigidBody};
 use nalgebra::Vector3;
@@ -70,6 +72,19 @@ pub enum MotorSpec {
     Torque(TorqueSpec),
     /// A PI loop holding the relative rate.
     SpeedHold(SpeedHoldSpec),
+    /// This wheel's share of a discrete rate-damping law for the hub.
+    RateDamping(RateDampingSpec),
+}
+
+/// `rate_damping:` — every wheel with it forms one assembly that commands the hub torque −K ω,
+/// sampled at `sample_rate` and held (zero-order hold).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RateDampingSpec {
+    /// The gain K (N m s): the hub torque per unit body rate.
+    pub gain: Spanned<f64>,
+    /// How often the controller samples ω (Hz).
+    pub sample_rate: Spanned<f64>,
 }
 
 /// `torque:` — exactly one of `constant`, `linear`, `steps`.
@@ -170,13 +185,90 @@ fn profile(
     }
 }
 
-/// Builds the wheel(s) of one `wheel:` entry into `out`.
+/// The rate-damping law of every wheel with `motor: {rate_damping: …}`, in the order the
+/// wheels are built (copies included): one assembly, one gain and one sample rate, each wheel
+/// commanding its row of K A⁺ (A: the wheels' axes as columns). Checks the gain and the rate
+/// (the controller's ticks over `duration` count against the same limit as output samples).
+pub(super) fn rate_damping_laws(
+    path: &std::path::Path,
+    specs: &[Spanned<EffectorSpec>],
+    duration: f64,
+) -> Result<std::collections::VecDeque<RateDamping>, ScenarioError> {
+    let mut axes: Vec<Vector3<f64>> = Vec::new();
+    let mut law: Option<(f64, f64)> = None;
+    for (i, spanned) in specs.iter().enumerate() {
+        let EffectorSpec::Wheel(w) = &spanned.value else {
+            continue;
+        };
+        let Some(Spanned {
+            value: MotorSpec::RateDamping(r),
+            ..
+        }) = &w.motor
+        else {
+            continue;
+        };
+        let ck = Check {
+            path,
+            prefix: format!("effectors[{i}].wheel"),
+        };
+        let gain = ck.positive(&r.gain, "motor.rate_damping.gain", "N m s")?;
+        let rate = ck.positive(&r.sample_rate, "motor.rate_damping.sample_rate", "Hz")?;
+        let ticks = duration * rate;
+        if ticks > crate::scenario::MAX_SAMPLES {
+            return Err(ck.err(
+                &r.sample_rate,
+                "motor.rate_damping.sample_rate",
+                format!(
+                    "{ticks:.3e} controller samples ({duration:e} s at {rate:e} Hz) exceed the                      limit of {:e} that output samples have too; lower the rate or the duration",
+                    crate::scenario::MAX_SAMPLES
+                ),
+            ));
+        }
+        match law {
+            None => law = Some((gain, rate)),
+            Some((g, f)) if g == gain && f == rate => {}
+            Some((g, f)) => {
+                return Err(ck.err(
+                    &r.gain,
+                    "motor.rate_damping",
+                    format!(
+                        "the wheels under rate damping form one assembly with one law: expected                          gain {g} N m s and sample_rate {f} Hz as on the first such wheel, got                          {gain} N m s and {rate} Hz"
+                    ),
+                ));
+            }
+        }
+        let axis = ck.unit(&w.axis, "axis")?;
+        for rot in ck.copies(&w.copies)? {
+            axes.push(rot * axis);
+        }
+    }
+    let Some((gain, rate)) = law else {
+        return Ok(Default::default());
+    };
+    let a = nalgebra::DMatrix::from_fn(3, axes.len(), |r, c| axes[c][r]);
+    // A⁺ by the SVD: for axes spanning fewer than three dimensions the hub is damped in
+    // their span only.
+    let pinv = a
+        .pseudo_inverse(1e-12)
+        .expect("the SVD of a finite 3 × n matrix exists");
+    let clock = SampleClock::from_rate(rate);
+    Ok((0..axes.len())
+        .map(|j| RateDamping {
+            gains: gain * Vector3::new(pinv[(j, 0)], pinv[(j, 1)], pinv[(j, 2)]),
+            clock,
+        })
+        .collect())
+}
+
+/// Builds the wheel(s) of one `wheel:` entry into `out`; a wheel under rate damping takes its
+/// law from the front of `rate_damping` ([`rate_damping_laws`]).
 pub(super) fn build(
     ck: &Check,
     w: &MotorWheelSpec,
     name: String,
     shift: Vector3<f64>,
     hub: &RigidBody,
+    rate_damping: &std::cell::RefCell<std::collections::VecDeque<RateDamping>>,
     out: &mut Vec<Box<dyn Effector>>,
 ) -> Result<(), ScenarioError> {
     let axial = ck.positive(&w.axial_inertia, "axial_inertia", "kg m²")?;
@@ -221,6 +313,11 @@ pub(super) fn build(
         Some(m) => match &m.value {
             MotorSpec::Free => MotorMode::Free,
             MotorSpec::Torque(t) => MotorMode::Torque(profile(ck, t, m)?),
+            // Its gains come from the whole assembly ([`rate_damping_laws`]), below.
+            MotorSpec::RateDamping(_) => MotorMode::RateDamping(RateDamping {
+                gains: Vector3::zeros(),
+                clock: SampleClock { period: 1.0 },
+            }),
             MotorSpec::SpeedHold(h) => {
                 let rate = ck.finite(&Some(h.rate.clone()), "motor.speed_hold.rate", "rad/s")?;
                 match (&h.bandwidth, &h.kp, &h.ki) {
@@ -296,11 +393,20 @@ pub(super) fn build(
     }
     let count = rotations.len();
     for (k, rot) in rotations.into_iter().enumerate() {
+        let mode = match mode {
+            MotorMode::RateDamping(_) => MotorMode::RateDamping(
+                rate_damping
+                    .borrow_mut()
+                    .pop_front()
+                    .ok_or_else(|| ck.err(&w.axis, "motor", "rate-damping wheels miscounted"))?,
+            ),
+            ref other => other.clone(),
+        };
         out.push(Box::new(MotorWheel {
             name: copy_name(&name, k, count),
             axial_inertia: axial,
             axis: rot * axis,
-            mode: mode.clone(),
+            mode,
             max_torque,
             friction,
             initial_rate,
