@@ -1,11 +1,11 @@
 //! Dual-spin stability: the nonlinear runs of the shipped dual-spin scenarios against the
-//! eigenvalues of `polhode linearize` about their steady states, and the despin manoeuvre's
-//! conservation and end state.
+//! eigenvalues of `polhode linearize` about their steady states, the weighted (dual-spin)
+//! energy-sink estimate in the CLI, and the despin manoeuvre's conservation and end state.
 
 mod common;
 
 use common::run;
-use polhode::linearize::{linearize, spin_rate_of};
+use polhode::linearize::{Linearization, linearize, spin_rate_of};
 use polhode::model::Observation;
 use polhode::scenario::{self, Overrides, Scenario};
 use polhode::sim::Status;
@@ -37,11 +37,15 @@ fn fitted_rate(samples: &[Observation], t0: f64, t1: f64) -> f64 {
     num / den
 }
 
+/// The linearisation about the scenario's steady state.
+fn linearization(s: &Scenario) -> Linearization {
+    let w = spin_rate_of(&s.spacecraft, &s.omega0);
+    linearize(&s.spacecraft, w).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// The nutation eigenvalue's real part (1/s) of the scenario's steady state.
 fn nutation_rate(s: &Scenario) -> f64 {
-    let w = spin_rate_of(&s.spacecraft, &s.omega0);
-    let lin = linearize(&s.spacecraft, w).unwrap_or_else(|e| panic!("{e}"));
-    lin.nutation.expect("a nutation mode").rate
+    linearization(s).nutation.expect("a nutation mode").rate
 }
 
 /// The damper on the despun platform damps the nutation of a minor-axis dual-spin
@@ -116,4 +120,39 @@ fn the_despin_manoeuvre_keeps_h_n_and_ends_despun() {
     // Torque-limited: Δω = 4.65458 rad/s at 20 N m on the platform's 104.969 kg m² (all but
     // the rotor's 300), about 24.4 s.
     assert!((despun.t - 24.4).abs() < 0.5, "despun at {} s", despun.t);
+}
+
+/// `polhode linearize` prints the weighted estimate beside the eigenvalue, and `--json` has
+/// it with its relative difference, the frequencies seen in each body and the damper's share.
+#[test]
+fn the_cli_prints_the_weighted_estimate() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/dual-spin.yaml");
+    let bin = env!("CARGO_BIN_EXE_polhode");
+    let text = std::process::Command::new(bin)
+        .arg("linearize")
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(text.status.success());
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("weighted (dual-spin) energy-sink estimate: -2.")
+            && text.contains("% from the eigenvalue"),
+        "{text}"
+    );
+    let json = std::process::Command::new(bin)
+        .args(["linearize", "--json", "-"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert!(json.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let w = &v["nutation"]["dual_spin_energy_sink"];
+    let rate = w["rate"].as_f64().unwrap();
+    let eigen = v["nutation"]["rate"].as_f64().unwrap();
+    let rel = w["relative_difference"].as_f64().unwrap();
+    assert!((rel - (rate - eigen) / eigen.abs()).abs() < 1e-12, "{w}");
+    assert_eq!(w["bodies"][0]["body"], "hub");
+    assert_eq!(w["bodies"][1]["body"], "rotor");
+    assert_eq!(w["sinks"][0]["effector"], "damper");
 }
