@@ -841,6 +841,36 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
                 100.0 * (r - n.rate) / n.rate.abs().max(f64::MIN_POSITIVE)
             );
         }
+        if let Some(w) = &n.dual_spin_energy_sink {
+            let tc = w
+                .time_constant
+                .map(|t| format!(" (time constant {t:.6} s)"))
+                .unwrap_or_default();
+            println!(
+                "  weighted (dual-spin) energy-sink estimate: {:.9e} 1/s{tc}, {:+.1}% from the \
+                 eigenvalue",
+                w.rate,
+                100.0 * w.relative_difference
+            );
+            for b in &w.bodies {
+                println!(
+                    "    nutation seen in {} (spin {:.6e} rad/s): λ = {:+.6e} rad/s",
+                    if b.body == "hub" {
+                        "the hub".to_string()
+                    } else {
+                        format!("`{}`", b.body)
+                    },
+                    b.spin_rate,
+                    b.nutation_frequency
+                );
+            }
+            for k in &w.sinks {
+                println!(
+                    "    `{}` on the {}: {:+.9e} 1/s",
+                    k.effector, k.body, k.rate
+                );
+            }
+        }
     } else if let Some(tc) = lin.time_constant {
         let what = if lin.max_growth_rate > 0.0 {
             "growth"

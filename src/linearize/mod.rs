@@ -25,9 +25,13 @@
 //! are the effectors' own modes. Beside the nutation rate this module gives the classic
 //! energy-sink estimate of it (Hughes 1986, ch. 5): drive the effectors with the locked
 //! body's nutation motion, average the power they dissipate ⟨P⟩, and with |H| fixed let the excess
-//! energy ΔE = T − h²/(2 I_s) of the nutation decay (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). It is
-//! good for well-damped dampers only (and not given for a gyrostat, whose energy function
-//! differs); the eigenvalue is the reference.
+//! energy ΔE = T − h²/(2 I_s) of the nutation decay (or grow) at σ = −⟨P⟩ / (2 ⟨ΔE⟩). For a
+//! gyrostat whose rotors spin relative to the hub (a dual-spin spacecraft) it gives instead
+//! the weighted estimate (Iorillo 1965; Likins 1967; Hughes 1986, ch. 7): each body's
+//! dissipation weighted by the inverse of the nutation frequency seen in that body
+//! ([`DualSpinEnergySink`]). Both assume the effectors follow the locked motion; they are
+//! approximate for a damper tuned near the nutation frequency, and the eigenvalue is the
+//! reference.
 //!
 //! A gravity-gradient spacecraft in a circular orbit is linearised instead about its
 //! LVLH-fixed equilibrium: [`lvlh`].
@@ -75,6 +79,9 @@ pub struct Nutation {
     pub energy_sink_rate: Option<f64>,
     /// 1/|energy_sink_rate| (s).
     pub energy_sink_time_constant: Option<f64>,
+    /// The weighted (dual-spin) energy-sink estimate, for a gyrostat whose rotors spin
+    /// relative to the hub, when effectors with their own states dissipate energy.
+    pub dual_spin_energy_sink: Option<DualSpinEnergySink>,
 }
 
 /// The linearisation's result.
@@ -554,15 +561,44 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
     };
 
     let nutation = nutation_value.map(|v| {
-        let estimate = (rigid.frequency > 0.0 && !spinning)
-            .then(|| energy_sink_estimate(sc, &y_eq, &idx, &inertia, &s, rigid.frequency))
+        // The whole spacecraft's momentum at the equilibrium: Iω plus the rotors' h.
+        let momentum = inertia * omega
+            + rotors
+                .iter()
+                .map(|r| r.momentum_per_rate * r.rate)
+                .sum::<Vector3<f64>>();
+        let driven = (rigid.frequency > 0.0)
+            .then(|| {
+                drive_with_locked_nutation(sc, &y_eq, &idx, &inertia, &momentum, rigid.frequency)
+            })
             .flatten();
+        let estimate = driven
+            .as_ref()
+            .filter(|_| !spinning)
+            .and_then(|d| energy_sink_estimate(d, &inertia, &s));
+        let dual_spin_energy_sink = driven.as_ref().filter(|_| spinning).and_then(|d| {
+            dual_spin_energy_sink(
+                sc,
+                d,
+                &rotors,
+                &DualSpinSteadyState {
+                    inertia: &inertia,
+                    spin_axis: &s,
+                    hub_rate: spin_rate,
+                    axial_momentum: momentum.dot(&s),
+                    nu: rigid.frequency,
+                    i_a,
+                    eigen_rate: v.re,
+                },
+            )
+        });
         Nutation {
             rate: v.re,
             frequency: v.im.abs(),
             time_constant: (v.re.abs() > zero).then(|| 1.0 / v.re.abs()),
             energy_sink_rate: estimate,
             energy_sink_time_constant: estimate.filter(|r| r.abs() > 0.0).map(|r| 1.0 / r.abs()),
+            dual_spin_energy_sink,
         }
     });
 
@@ -690,16 +726,30 @@ pub fn linearize_driven(
     })
 }
 
-/// The energy-sink estimate of the nutation rate (1/s), or `None` when no effector with
-/// states dissipates. `idx` lists ω then the effectors' dynamic states.
-fn energy_sink_estimate(
+/// The effectors driven by the locked spacecraft's nutation mode (energy-sink argument: the
+/// effectors follow the rigid motion and do not change it), and the power they dissipate.
+struct DrivenNutation {
+    /// The locked nutation mode δω(t) = Re(v e^{iνt}) (rad/s, body axes).
+    mode: [C64; 3],
+    /// ⟨P⟩ of all the effectors together (W), for that mode.
+    mean_power: f64,
+    /// ⟨P⟩ of each effector whose states dissipate (W): its index in
+    /// `Spacecraft::effectors` and its mean power.
+    effector_power: Vec<(usize, f64)>,
+}
+
+/// Drives the effectors with the locked nutation mode at frequency `nu` (rad/s) about the
+/// equilibrium `y_eq` and averages the power they dissipate; `None` when no effector with
+/// states dissipates. `idx` lists ω then the effectors' dynamic states; `momentum` is the
+/// whole spacecraft's H at the equilibrium (N m s, body axes; Iω plus the rotors' h).
+fn drive_with_locked_nutation(
     sc: &Spacecraft,
     y_eq: &[f64],
     idx: &[usize],
     inertia: &Matrix3<f64>,
-    spin_axis: &Vector3<f64>,
+    momentum: &Vector3<f64>,
     nu: f64,
-) -> Option<f64> {
+) -> Option<DrivenNutation> {
     let x_idx = &idx[3..];
     let nx = x_idx.len();
     if nx == 0 {
@@ -707,10 +757,12 @@ fn energy_sink_estimate(
     }
     let n = sc.dim();
     let omega_eq = Vector3::new(y_eq[0], y_eq[1], y_eq[2]);
-    // The locked body's nutation mode: δω̇ = A δω, A = I⁻¹([h×] − [Ω×] I).
+    // The locked spacecraft's nutation mode: I δω̇ = −δω × H − ω × I δω, so
+    // δω̇ = A δω with A = I⁻¹([H×] − [ω×] I) (H = Iω for a rigid body, Iω + h for a gyrostat
+    // whose rotors are locked at their relative rates).
     let cross = |v: &Vector3<f64>| Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0);
     let inv = inertia.try_inverse()?;
-    let a = inv * (cross(&(inertia * omega_eq)) - cross(&omega_eq) * inertia);
+    let a = inv * (cross(momentum) - cross(&omega_eq) * inertia);
     let lambda = C64::new(0.0, nu);
     let shifted =
         a.map(|x| C64::new(x, 0.0)) - Matrix3::identity().map(|x| C64::new(x, 0.0)) * lambda;
@@ -787,13 +839,42 @@ fn energy_sink_estimate(
     if d.amax() == 0.0 {
         return None;
     }
-    // ⟨P⟩ = ¼ Re(Xᴴ D X) for x(t) = Re(X e^{iνt}).
-    let dx = d.map(|x| C64::new(x, 0.0)) * &x;
-    let mean_power = 0.25
-        * x.iter()
-            .zip(dx.iter())
-            .map(|(a, b)| (a.conj() * b).re)
-            .sum::<f64>();
+    // ⟨P⟩ = ¼ Re(Xᴴ D X) for x(t) = Re(X e^{iνt}), over the positions `rows` of X.
+    let mean_power_of = |rows: &[usize]| {
+        0.25 * rows
+            .iter()
+            .flat_map(|&r| rows.iter().map(move |&c| (r, c)))
+            .map(|(r, c)| (x[r].conj() * x[c] * d[(r, c)]).re)
+            .sum::<f64>()
+    };
+    let all: Vec<usize> = (0..nx).collect();
+    let mean_power = mean_power_of(&all);
+    // Each effector's power depends on its own states only: its block of D.
+    let effector_power = (0..sc.effectors().len())
+        .filter_map(|k| {
+            let first = sc.effector_offset(k);
+            let own = first..first + sc.effectors()[k].num_dynamic_states();
+            let rows: Vec<usize> = (0..nx).filter(|&r| own.contains(&x_idx[r])).collect();
+            let dissipates = rows.iter().any(|&r| rows.iter().any(|&c| d[(r, c)] != 0.0));
+            dissipates.then(|| (k, mean_power_of(&rows)))
+        })
+        .collect();
+    Some(DrivenNutation {
+        mode: v,
+        mean_power,
+        effector_power,
+    })
+}
+
+/// The single-body energy-sink estimate of the nutation rate (1/s) from the driven
+/// effectors: σ = −⟨P⟩ / (2 ⟨ΔE⟩), ΔE = T − H²/(2 I_s) = ½ Σ I_i (1 − I_i/I_s) δω_i² in
+/// principal axes (Hughes 1986, ch. 5).
+fn energy_sink_estimate(
+    driven: &DrivenNutation,
+    inertia: &Matrix3<f64>,
+    spin_axis: &Vector3<f64>,
+) -> Option<f64> {
+    let v = &driven.mode;
     // ⟨ΔE⟩ = ½ Σ I_i (1 − I_i/I_s) ⟨δω_i²⟩, ⟨δω_i²⟩ = ½|v_i|², in principal axes.
     let (moments, axes) = principal(inertia);
     let i_s = spin_axis.dot(&(inertia * spin_axis));
@@ -806,7 +887,146 @@ fn energy_sink_estimate(
     if mean_excess == 0.0 {
         return None;
     }
-    Some(-mean_power / (2.0 * mean_excess))
+    Some(-driven.mean_power / (2.0 * mean_excess))
+}
+
+/// The weighted (dual-spin) energy-sink estimate of the nutation rate: each body's
+/// dissipation weighted by the inverse of the nutation frequency seen in that body (Iorillo
+/// 1965; Likins 1967; Hughes 1986, ch. 7; the derivation is in docs/actuators.md).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct DualSpinEnergySink {
+    /// The estimated growth (> 0) or decay (< 0) rate of the nutation amplitude (1/s).
+    pub rate: f64,
+    /// 1/|rate| (s).
+    pub time_constant: Option<f64>,
+    /// (rate − the nutation eigenvalue's real part) / |that real part|: the estimate's error
+    /// against the eigenvalue, the reference.
+    pub relative_difference: f64,
+    /// The bodies turning about the spin axis: the hub first, then each rotor spinning
+    /// relative to it.
+    pub bodies: Vec<BodyNutation>,
+    /// Each dissipating effector's share of `rate`; they sum to it.
+    pub sinks: Vec<SinkShare>,
+}
+
+/// One body of a dual-spin spacecraft and the nutation as that body sees it.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BodyNutation {
+    /// `hub`, or the rotor effector's name.
+    pub body: String,
+    /// Its absolute spin rate about the spin axis ŝ (rad/s).
+    pub spin_rate: f64,
+    /// λ: the rate at which the transverse angular velocity turns relative to this body,
+    /// counted positive in the sense of H about ŝ (rad/s). Dissipation in a body with λ > 0
+    /// damps the nutation; with λ < 0 it drives it.
+    pub nutation_frequency: f64,
+}
+
+/// One dissipating effector's share of the weighted energy-sink estimate.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SinkShare {
+    /// The effector's name.
+    pub effector: String,
+    /// The body that carries it (`hub`: every effector with states rides on the hub).
+    pub body: String,
+    /// Its contribution to the estimated rate (1/s): −⟨P⟩ / (2⟨ΔE⟩).
+    pub rate: f64,
+}
+
+/// What the weighted estimate needs about the steady state besides the driven effectors.
+struct DualSpinSteadyState<'a> {
+    /// The spacecraft's locked inertia (kg m², body axes).
+    inertia: &'a Matrix3<f64>,
+    /// ŝ (body axes).
+    spin_axis: &'a Vector3<f64>,
+    /// The hub's spin rate about ŝ (rad/s).
+    hub_rate: f64,
+    /// H·ŝ: the whole spacecraft's momentum along ŝ (N m s).
+    axial_momentum: f64,
+    /// The locked nutation frequency in the hub, ν (rad/s), and a transverse principal moment
+    /// I_a (kg m²): λ in the hub is ±ν with the sign of H·ŝ/I_a − ω.
+    nu: f64,
+    i_a: f64,
+    /// The nutation eigenvalue's real part (1/s), the reference.
+    eigen_rate: f64,
+}
+
+/// The weighted estimate. With |H| fixed, the nutation angle θ obeys
+/// H·ŝ = |H| cos θ, and each body b with a damper changes H·ŝ at ⟨P_b⟩/λ_b (docs/actuators.md);
+/// for the hub (which carries every effector here) this is σ = −⟨P⟩ / (2⟨ΔE⟩) with
+/// ΔE = ½ Σ_⊥ I_k (1 − I_k ω/(H·ŝ)) δω_k² over the transverse principal axes, which for an
+/// axisymmetric hub is ½ |H| θ² λ_hub. A spinning rotor's own bearing friction is an axial
+/// torque between hub and rotor: it cancels in H·ŝ, so it is no nutation sink here (and the
+/// locked mode does not drive it on the axis).
+fn dual_spin_energy_sink(
+    sc: &Spacecraft,
+    driven: &DrivenNutation,
+    rotors: &[Rotor],
+    steady: &DualSpinSteadyState,
+) -> Option<DualSpinEnergySink> {
+    let s = steady.spin_axis;
+    let h3 = steady.axial_momentum;
+    if h3 == 0.0 {
+        return None;
+    }
+    // ⟨ΔE⟩ = ¼ Re(u_⊥ᴴ I u_⊥) − ¼ (ω/H·ŝ) |P I u_⊥|², P the projection across ŝ.
+    let u: Vec<C64> = (0..3).map(|r| driven.mode[r]).collect();
+    let along: C64 = (0..3).map(|r| u[r] * s[r]).sum();
+    let u_perp: Vec<C64> = (0..3).map(|r| u[r] - along * s[r]).collect();
+    let iu: Vec<C64> = (0..3)
+        .map(|r| (0..3).map(|c| u_perp[c] * steady.inertia[(r, c)]).sum())
+        .collect();
+    let iu_along: C64 = (0..3).map(|r| iu[r] * s[r]).sum();
+    let uiu: f64 = (0..3).map(|r| (u_perp[r].conj() * iu[r]).re).sum();
+    let piu_sq: f64 = (0..3).map(|r| (iu[r] - iu_along * s[r]).norm_sqr()).sum();
+    let mean_excess = 0.25 * uiu - 0.25 * (steady.hub_rate / h3) * piu_sq;
+    if mean_excess == 0.0 || !mean_excess.is_finite() {
+        return None;
+    }
+    let spinning: Vec<&Rotor> = rotors.iter().filter(|r| r.rate != 0.0).collect();
+    let rotor_effector = |k: usize| {
+        let first = sc.effector_offset(k);
+        spinning.iter().any(|r| r.index == first)
+    };
+    let sinks: Vec<SinkShare> = driven
+        .effector_power
+        .iter()
+        .filter(|&&(k, _)| !rotor_effector(k))
+        .map(|&(k, p)| SinkShare {
+            effector: sc.effectors()[k].name().to_string(),
+            body: "hub".into(),
+            rate: -p / (2.0 * mean_excess),
+        })
+        .collect();
+    if sinks.is_empty() {
+        return None;
+    }
+    let rate: f64 = sinks.iter().map(|x| x.rate).sum();
+    // λ in the hub, about ŝ: ±ν, with the sign of H·ŝ/I_a − ω (the transverse factors of
+    // the locked frequency share it when ν is real); then counted in the sense of H.
+    let sense = h3.signum();
+    let lambda_hub = sense * (h3 / steady.i_a - steady.hub_rate).signum() * steady.nu;
+    let mut bodies = vec![BodyNutation {
+        body: "hub".into(),
+        spin_rate: steady.hub_rate,
+        nutation_frequency: lambda_hub,
+    }];
+    for r in &spinning {
+        let relative = r.rate * r.momentum_per_rate.normalize().dot(s);
+        bodies.push(BodyNutation {
+            body: r.name.clone(),
+            spin_rate: steady.hub_rate + relative,
+            nutation_frequency: lambda_hub - sense * relative,
+        });
+    }
+    Some(DualSpinEnergySink {
+        rate,
+        time_constant: (rate != 0.0).then(|| 1.0 / rate.abs()),
+        relative_difference: (rate - steady.eigen_rate)
+            / steady.eigen_rate.abs().max(f64::MIN_POSITIVE),
+        bodies,
+        sinks,
+    })
 }
 
 /// The energy-sink coefficient c (N m s/rad) that makes the nutation of `hub` spinning at
