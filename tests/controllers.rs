@@ -457,3 +457,42 @@ fn bad_controllers_are_refused_with_located_errors() {
         assert!(e.starts_with("test.yaml:"), "{e}");
     }
 }
+
+/// B-dot's backward difference holds while the body turns by much less than a radian between
+/// samples: the run warns past 1 rad and stops with a diagnosis past π, where the samples
+/// alias. The CubeSat at 0.30 rad/s sampled every 5 s turns 1.5 rad per sample; every 12 s,
+/// 3.6 rad.
+#[test]
+fn bdot_sampled_too_slowly_warns_then_stops() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cubesat-detumble.yaml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let with_rate = |hz: &str| {
+        let yaml = text.replace("sample_rate: 1.0}", &format!("sample_rate: {hz}}}"));
+        assert!(yaml.contains(&format!("sample_rate: {hz}}}")));
+        let ov = Overrides {
+            duration: Some(600.0),
+            ..Overrides::default()
+        };
+        parse(Path::new("slow.yaml"), yaml, &ov).unwrap()
+    };
+    let (out, _) = run(&with_rate("0.2"));
+    assert_eq!(out.status, Status::Complete);
+    assert_eq!(out.warnings.len(), 1, "{:?}", out.warnings);
+    assert!(
+        out.warnings[0].message.contains("the body turned by 1.51"),
+        "{}",
+        out.warnings[0].message
+    );
+    let (out, _) = run(&with_rate("0.0833333333333"));
+    let Status::InvalidModel { diagnosis } = &out.status else {
+        panic!("{:?}", out.status);
+    };
+    assert!(
+        diagnosis.contains("magnetorquer `coils` left the range")
+            && diagnosis.contains("a higher `bdot.sample_rate`"),
+        "{diagnosis}"
+    );
+    // At 1 Hz (0.30 rad per sample) nothing is said.
+    let (out, _) = run(&with_rate("1.0"));
+    assert!(out.warnings.is_empty(), "{:?}", out.warnings);
+}

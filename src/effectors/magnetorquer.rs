@@ -20,12 +20,19 @@
 //! until the next tick (zero-order hold); the first tick (t = 0) has no difference yet and
 //! commands m = 0. The gain's unit is N m s (kg m²/s).
 //!
+//! **Where the law holds.** Between samples the body turns by φ = |ω| Δt. The backward
+//! difference is the chord of the sampled directions: it lags the rate it estimates by φ/2
+//! and shortens it by 2 sin(φ/2)/φ, so the torque's damping part falls as cos(φ/2) and
+//! vanishes at φ = π, where the samples alias; beyond, the law pumps energy in. The run warns
+//! once past φ = 1 rad (a lag of 29°) and stops past π (`checks.on_validity`).
+//!
 //! States, all held between ticks but the last: m (3, A m²); the last sampled direction b
-//! (3); the number of samples taken; the work W (J).
+//! (3); the number of samples taken; the rotation per sample φ at the last tick (rad); the
+//! work W (J).
 
 use super::clock::SampleClock;
 use super::magnetic_dipole::field_body;
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Validity};
 use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -40,8 +47,15 @@ pub fn optimal_gain(orbit: &Orbit, inertia: &nalgebra::Matrix3<f64>) -> f64 {
     2.0 * orbit.mean_motion() * (1.0 + xi.sin()) * j_min
 }
 
+/// Index of the rotation-per-sample state.
+const TURN: usize = 7;
 /// Index of the work state.
-const WORK: usize = 7;
+const WORK: usize = 8;
+
+/// Rotation per sample φ = |ω| Δt (rad) past which the run warns: the difference lags by 29°.
+pub const TURN_WARN: f64 = 1.0;
+/// Rotation per sample past which the samples alias and the law no longer damps (rad).
+pub const TURN_LIMIT: f64 = std::f64::consts::PI;
 
 /// Magnetorquer coils under B-dot control.
 #[derive(Debug, Clone)]
@@ -109,6 +123,7 @@ impl Effector for Magnetorquer {
             "sampled_direction_y",
             "sampled_direction_z",
             "samples",
+            "rotation_per_sample",
             "work",
         ]
         .iter()
@@ -135,6 +150,23 @@ impl Effector for Magnetorquer {
         x[..3].copy_from_slice(m.as_slice());
         x[3..6].copy_from_slice(dir.as_slice());
         x[6] += 1.0;
+        x[TURN] = hub.omega.norm() * self.clock.period;
+    }
+    fn validity(&self, x: &[f64]) -> Option<Validity> {
+        Some(Validity {
+            value: x[TURN],
+            warn: TURN_WARN,
+            limit: TURN_LIMIT,
+        })
+    }
+    fn validity_report(&self, x: &[f64]) -> (String, String) {
+        (
+            format!(
+                "B-dot samples the field every {} s and the body turned by {:.4} rad between                  samples (warning at {TURN_WARN} rad, limit π: the backward difference lags                  the field's rate by half of that and stops damping at π, where the samples                  alias)",
+                self.clock.period, x[TURN]
+            ),
+            "a higher `bdot.sample_rate`".into(),
+        )
     }
     fn scratch_len(&self) -> usize {
         3
@@ -170,8 +202,18 @@ impl Effector for Magnetorquer {
     }
     fn telemetry_names(&self) -> Vec<String> {
         [
-            "dipole_x", "dipole_y", "dipole_z", "torque_x", "torque_y", "torque_z", "b_x", "b_y",
-            "b_z", "samples", "work",
+            "dipole_x",
+            "dipole_y",
+            "dipole_z",
+            "torque_x",
+            "torque_y",
+            "torque_z",
+            "b_x",
+            "b_y",
+            "b_z",
+            "samples",
+            "rotation_per_sample",
+            "work",
         ]
         .iter()
         .map(|s| s.to_string())
@@ -182,7 +224,7 @@ impl Effector for Magnetorquer {
         let m = Self::dipole(x);
         let tau = m.cross(&b);
         vec![
-            m.x, m.y, m.z, tau.x, tau.y, tau.z, b.x, b.y, b.z, x[6], x[WORK],
+            m.x, m.y, m.z, tau.x, tau.y, tau.z, b.x, b.y, b.z, x[6], x[TURN], x[WORK],
         ]
     }
 }

@@ -320,6 +320,12 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
                 DIMENSIONLESS,
             );
         }
+        ("magnetorquer", "rotation_per_sample") => {
+            return fixed(
+                "Body rotation between field samples at the last tick, |omega| dt",
+                "rad",
+            );
+        }
         ("magnetorquer", "work") => {
             return fixed("Work done by the coils' torque since the start", "J");
         }
