@@ -67,6 +67,13 @@ enum Command {
         /// Write a JSON summary here.
         #[arg(long)]
         summary: Option<PathBuf>,
+        /// Write the sampled telemetry (every output sample, effectors' fields included) as
+        /// CSV here, units in the header.
+        #[arg(long, value_name = "FILE")]
+        csv: Option<PathBuf>,
+        /// Write the sampled telemetry as Parquet here, units in the file's metadata.
+        #[arg(long, value_name = "FILE")]
+        parquet: Option<PathBuf>,
         /// Largest log to write (MB, 10⁶ bytes; overrides `output.max_log_mb`, default 2000):
         /// a run whose log is estimated larger is refused before it starts.
         #[arg(long, value_name = "MB")]
@@ -348,6 +355,8 @@ pub fn main() -> i32 {
             method,
             duration,
             summary,
+            csv,
+            parquet,
             max_log_mb,
             quiet,
         } => {
@@ -355,7 +364,13 @@ pub fn main() -> i32 {
                 max_log_mb,
                 ..method.overrides(duration, out)
             };
-            run(&scenario, &overrides, no_log, summary.as_deref(), quiet)
+            let outputs = RunOutputs {
+                no_log,
+                summary: summary.as_deref(),
+                csv: csv.as_deref(),
+                parquet: parquet.as_deref(),
+            };
+            run(&scenario, &overrides, &outputs, quiet)
         }
     }
 }
@@ -968,13 +983,20 @@ fn probe_writable(path: &Path) -> std::io::Result<()> {
     std::fs::remove_file(&tmp)
 }
 
-fn run(
-    path: &Path,
-    overrides: &Overrides,
+/// What `polhode run` writes besides its text.
+struct RunOutputs<'a> {
+    /// No MCAP log.
     no_log: bool,
-    summary_path: Option<&Path>,
-    quiet: bool,
-) -> i32 {
+    /// The JSON summary.
+    summary: Option<&'a Path>,
+    /// The sampled telemetry as CSV.
+    csv: Option<&'a Path>,
+    /// The sampled telemetry as Parquet.
+    parquet: Option<&'a Path>,
+}
+
+fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quiet: bool) -> i32 {
+    let (no_log, summary_path) = (outputs.no_log, outputs.summary);
     let s = match load(path, overrides) {
         Ok(s) => s,
         Err(c) => return c,
@@ -998,6 +1020,48 @@ fn run(
         eprintln!("error: cannot write the summary to {}: {e}", p.display());
         return EXIT_BAD_INPUT;
     }
+    // No two outputs may be the same file.
+    let named: Vec<(&str, &Path)> = [
+        ("--summary", summary_path),
+        ("--csv", outputs.csv),
+        ("--parquet", outputs.parquet),
+        ("the log", (!no_log).then_some(s.mcap_path.as_path())),
+    ]
+    .into_iter()
+    .filter_map(|(what, p)| p.map(|p| (what, p)))
+    .collect();
+    for (i, (a, pa)) in named.iter().enumerate() {
+        for (b, pb) in &named[i + 1..] {
+            if same_file(pa, pb) {
+                eprintln!(
+                    "error: {a} and {b} both name {}; give each output its own file",
+                    pa.display()
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    let mut table = if outputs.csv.is_some() || outputs.parquet.is_some() {
+        match crate::log::samples::SampleTable::create(&s.spacecraft, outputs.csv, outputs.parquet)
+        {
+            Ok(t) => Some(t),
+            Err(e) => {
+                eprintln!(
+                    "error: cannot write the sampled telemetry to {}: {e}",
+                    outputs
+                        .csv
+                        .into_iter()
+                        .chain(outputs.parquet)
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(" / ")
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    } else {
+        None
+    };
     let mut logger = if no_log {
         None
     } else {
@@ -1068,9 +1132,11 @@ fn run(
         interrupt: &interrupt,
         progress: Some(&mut progress),
     };
-    let result = match logger.as_mut() {
-        Some(l) => sim::run(&s, l, ctl),
-        None => sim::run(&s, &mut NullSink, ctl),
+    let result = match (logger.as_mut(), table.as_mut()) {
+        (Some(l), Some(t)) => sim::run(&s, &mut crate::log::samples::Both(l, t), ctl),
+        (Some(l), None) => sim::run(&s, l, ctl),
+        (None, Some(t)) => sim::run(&s, t, ctl),
+        (None, None) => sim::run(&s, &mut NullSink, ctl),
     };
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -1085,6 +1151,19 @@ fn run(
             return EXIT_IO;
         }
     };
+    let mut tables = Vec::new();
+    if let Some(t) = table {
+        match t.finish() {
+            Ok(paths) => tables = paths,
+            Err(e) => {
+                eprintln!("error: finishing the sampled telemetry failed: {e}; no table was kept");
+                if let Some(l) = logger {
+                    l.abandon();
+                }
+                return EXIT_IO;
+            }
+        }
+    }
     let mut written = None;
     if let Some(l) = logger {
         match l.finish(&s, &s.method.describe(), &outcome) {
@@ -1107,6 +1186,9 @@ fn run(
     }
     if !quiet {
         print_summary(&s, &outcome, written.as_deref());
+        for p in &tables {
+            println!("  table: {}", p.display());
+        }
     }
     for w in &outcome.warnings {
         eprintln!("warning: {}", w.message);

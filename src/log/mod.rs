@@ -14,6 +14,7 @@
 
 pub mod orbit;
 pub mod orbit_scene;
+pub mod samples;
 pub mod telemetry;
 pub mod units;
 
