@@ -140,6 +140,18 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Charts of one run from its MCAP log (ω, nutation angle, energies, effector
+    /// coordinates) as SVG and PNG, without a viewer.
+    Plot {
+        /// The run's MCAP log.
+        log: PathBuf,
+        /// Output directory (default: beside the log, `<log stem>-plots`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print nothing but errors.
+        #[arg(long, short)]
+        quiet: bool,
+    },
     /// Combine the outputs of all shards of a campaign into the result of the whole campaign.
     Merge {
         /// Shard output directories (one per shard).
@@ -347,6 +359,7 @@ pub fn main() -> i32 {
             quiet,
         } => montecarlo_cmd(&scenario, runs, seed, threads, shard.as_deref(), out, quiet),
         Command::Merge { dirs, out, quiet } => merge_cmd(&dirs, &out, quiet),
+        Command::Plot { log, out, quiet } => plot_cmd(&log, out, quiet),
         Command::Bench { what } => bench_cmd(what),
         Command::Run {
             scenario,
@@ -372,6 +385,23 @@ pub fn main() -> i32 {
             };
             run(&scenario, &overrides, &outputs, quiet)
         }
+    }
+}
+
+fn plot_cmd(log: &Path, out: Option<PathBuf>, quiet: bool) -> i32 {
+    let dir = out.unwrap_or_else(|| {
+        let stem = log
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "run".into());
+        log.with_file_name(format!("{stem}-plots"))
+    });
+    match crate::log::charts::read(log) {
+        Err(e) => {
+            eprintln!("error: {e}");
+            EXIT_BAD_INPUT
+        }
+        Ok(run) => report_files(crate::log::charts::write(&run, &dir), quiet),
     }
 }
 

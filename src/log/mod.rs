@@ -12,6 +12,7 @@
 //! Log time = scenario epoch + sim time. The file is written under a temporary name in the
 //! target directory and renamed when finished, so a final name never holds a half-written log.
 
+pub mod charts;
 pub mod orbit;
 pub mod orbit_scene;
 pub mod samples;
