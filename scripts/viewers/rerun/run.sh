@@ -51,7 +51,7 @@ if [[ -n "${actuators}" ]]; then
 fi
 # Largest PNG to keep as it is (bytes; 0: any); a larger one is written with 256 colours.
 max_png=0
-[[ -n "${actuators}" ]] && max_png=390000
+[[ -n "${actuators}" ]] && max_png=399000
 
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 seconds() { local d=$(($(now_ms) - $1)); printf '%d.%01d s' $((d / 1000)) $((d % 1000 / 100)); }
@@ -221,12 +221,19 @@ shoot() {
             local small="${logs}/${name}.screenshot.small.png"
             "${py}" -c 'import sys; from PIL import Image; im = Image.open(sys.argv[1]).convert("RGB")
 if im.width > 1600: im = im.resize((1600, round(im.height * 1600 / im.width)), Image.LANCZOS)
-im.save(sys.argv[2], optimize=True)
-import os
-if int(sys.argv[3]) and os.path.getsize(sys.argv[2]) > int(sys.argv[3]): im.quantize(256).save(sys.argv[2], optimize=True)' \
-                "${shot}" "${small}" "${max_png}"
+im.save(sys.argv[2], optimize=True)' \
+                "${shot}" "${small}"
             if "${py}" "${here}/check.py" "${rec}.mcap" --no-raw --png "${small}" "$@" > "${logs}/${name}.screenshot.check.txt"; then
-                cp "${small}" "${dest}.tmp" && mv "${dest}.tmp" "${dest}"
+                if ((max_png)) && (($(stat -c %s "${small}") > max_png)); then
+                    # Checked in full colour; written with 256 colours to stay under max_png.
+                    "${py}" -c 'import sys; from PIL import Image
+Image.open(sys.argv[1]).quantize(256).save(sys.argv[2], format="PNG", optimize=True)' \
+                        "${small}" "${dest}.tmp"
+                    echo "  $(stat -c %s "${small}") bytes > ${max_png}: written with 256 colours"
+                else
+                    cp "${small}" "${dest}.tmp"
+                fi
+                mv "${dest}.tmp" "${dest}"
                 ok=1; break
             fi
             cat "${logs}/${name}.screenshot.check.txt"
