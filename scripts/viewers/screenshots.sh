@@ -10,11 +10,25 @@
 #     path and the marker.
 #
 #   scripts/viewers/screenshots.sh [OUT_DIR]     (default docs/figures/viewing)
+#   scripts/viewers/screenshots.sh --actuators [OUT_DIR]   (default docs/figures/actuators)
+#
+# --actuators: the pictures of docs/actuators.md instead (not run by scripts/test.sh; about
+# 4 minutes): the dual-spin scenes in Foxglove (the rotor disc drawn, the nutation decaying or
+# growing), the reaction-wheel pyramid (four discs) and the CubeSat detumbling in orbit in
+# Rerun, each checked as the ones above and for the effectors' red and the decay of |ω|.
 #
 # Installs what is missing (Debian packages, npm and PyPI packages; needs root for apt).
 # Exits non-zero if any check fails. POLHODE selects the binary (default target/release/polhode).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+if [ "${1:-}" = "--actuators" ]; then
+  out=$(realpath -m "${2:-docs/figures/actuators}")
+  mkdir -p "$out"
+  status=0
+  ACTUATORS=1 OUT="$out" scripts/viewers/foxglove/run.sh || status=$?
+  ACTUATORS=1 OUT_DIR="$out" scripts/viewers/rerun/run.sh || status=$?
+  exit "$status"
+fi
 out=$(realpath -m "${1:-docs/figures/viewing}")
 mkdir -p "$out"
 OUT="$out" scripts/viewers/foxglove/run.sh

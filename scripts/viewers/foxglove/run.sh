@@ -18,11 +18,23 @@
 # plotted series visible: true of explorer1-pydy, not of a rigid body, whose dissipated and
 # elastic energies are both 0 and hide each other (so the orbit capture only wants the plots
 # not blank).
+#
+# ACTUATORS=1 (scripts/viewers/screenshots.sh --actuators): instead, the actuator scenes of
+# docs/actuators.md, each checked as above and with its rotor disc drawn (--effectors):
+# dual-spin.yaml (150 s log, at 15 and 90 s: the nutation decaying) and
+# dual-spin-rotor-damper.yaml (150 s, at 20 and 120 s: the drift toward the flat spin), written
+# to $OUT/foxglove-dual-spin-{early,late}.png and $OUT/foxglove-dual-spin-rotor-damper-*.png
+# (OUT defaults to docs/figures/actuators then).
 set -euo pipefail
 
 here="$(cd "$(dirname "$0")" && pwd)"
 repo="$(cd "$here/../../.." && pwd)"
-out="${OUT:-$repo/docs/figures/viewing}"
+actuators="${ACTUATORS:-}"
+if [ -n "$actuators" ]; then
+  out="${OUT:-$repo/docs/figures/actuators}"
+else
+  out="${OUT:-$repo/docs/figures/viewing}"
+fi
 scenario="${SCENARIO:-$repo/scenarios/explorer1-pydy.yaml}"
 chromium="${CHROMIUM:-/usr/bin/chromium}"
 now() { date +%s.%N; }
@@ -65,6 +77,40 @@ fi
 # 3. The log, in a temporary folder removed on exit.
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+
+# The actuator scenes (ACTUATORS=1): NAME DURATION EARLY LATE MIN_EFFECTOR_PIXELS per line.
+if [ -n "$actuators" ]; then
+  status=0
+  written=()
+  t_shots=$(now)
+  while read -r name duration early late min_effector; do
+    alog="$work/$name.mcap"
+    if ! "$polhode" run "$repo/scenarios/$name.yaml" --out "$alog" --duration "$duration" \
+      </dev/null >"$work/polhode-$name.txt" 2>&1; then
+      cat "$work/polhode-$name.txt" >&2
+      echo "FAIL: polhode could not make the log of $name" >&2
+      status=1
+      continue
+    fi
+    echo "== $name: $(du -h "$alog" | cut -f1) log of $duration s"
+    if node "$here/screenshots.mjs" --log "$alog" --out "$out" --chromium "$chromium" \
+      --name "foxglove-$name" --early "$early" --late "$late" --effectors "$min_effector" </dev/null; then
+      written+=("$out/foxglove-$name-early.png" "$out/foxglove-$name-late.png")
+    else
+      status=1
+    fi
+  done <<'SCENES'
+dual-spin 150 15 90 2000
+dual-spin-rotor-damper 150 20 120 2000
+SCENES
+  echo "screenshots: $(since "$t_shots") s"
+  if [ "$status" -eq 0 ]; then
+    echo "PASS (foxglove, actuators): ${written[*]}"
+  else
+    echo "FAIL (foxglove, actuators)"
+  fi
+  exit "$status"
+fi
 log="$work/$(basename "$scenario" .yaml).mcap"
 t_log=$(now)
 if ! "$polhode" run "$scenario" --out "$log" >"$work/polhode.txt" 2>&1; then

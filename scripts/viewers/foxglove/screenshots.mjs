@@ -5,10 +5,12 @@
 // orbit), the orbit panel is checked instead of the series: the Earth, the orbit path and the
 // spacecraft marker are drawn and the panel changed between the two times (the spacecraft
 // moved, the Earth turned); the plots need only not be blank (a rigid body's energies are 0
-// and hide each other). Exits 1 with a message when a check fails.
+// and hide each other). With --effectors N, the body's 3D panel must also show at least N
+// pixels of the effectors' red (a rotor or wheel disc, seen through the translucent body) at
+// both times. Exits 1 with a message when a check fails.
 //
 //   node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S] [--orbit]
-//                        [--name NAME] [--chromium PATH] [--timeout S]
+//                        [--name NAME] [--effectors N] [--chromium PATH] [--timeout S]
 //
 // --early and --late are seconds after the log's first message (default 10 and 120).
 // Screenshots: DIR/NAME-early.png and DIR/NAME-late.png (NAME defaults to foxglove, or
@@ -41,6 +43,9 @@ const MIN_EARTH_PIXELS = 5000;
 const PATH_COLOUR = [77, 242, 242]; // rgb of (0.3, 0.95, 0.95) in src/log/orbit_scene.rs
 const MIN_PATH_PIXELS = 150;
 const MIN_MARKER_PIXELS = 20;
+// --effectors: pixels of the effectors' red, rgb(217, 51, 64) in src/log/mod.rs, alone or
+// through the body's translucent grey: red over green, a little blue over green (not the
+// orange of the omega arrow, which has less blue than green).
 
 const CHROMIUM_FLAGS = [
   "--no-sandbox",
@@ -158,19 +163,20 @@ window.regionStats = async (b64, rect, colours, tol, pixDiff) => {
     }
   }
   bg = bg.map((v) => v / m);
-  let fg = 0, grey = 0, blue = 0, magenta = 0;
+  let fg = 0, grey = 0, blue = 0, magenta = 0, effector = 0;
   const hits = colours.map(() => 0);
   for (const i of inside(im, rect)) {
     const hi = Math.max(d[i], d[i + 1], d[i + 2]), lo = Math.min(d[i], d[i + 1], d[i + 2]);
     if (hi >= 110 && hi - lo <= 25) grey++;
     if (d[i + 2] >= 70 && d[i + 2] - d[i] >= 40 && d[i + 2] - d[i + 1] >= 15) blue++;
     if (d[i] >= 150 && d[i + 2] >= 110 && d[i] - d[i + 1] >= 90 && d[i + 2] - d[i + 1] >= 60) magenta++;
+    if (d[i] >= 100 && d[i] - d[i + 1] >= 12 && d[i + 2] - d[i + 1] >= 4 && d[i] - d[i + 2] >= 5) effector++;
     if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > pixDiff) fg++;
     colours.forEach((c, k) => {
       if (Math.abs(d[i] - c[0]) <= tol && Math.abs(d[i + 1] - c[1]) <= tol && Math.abs(d[i + 2] - c[2]) <= tol) hits[k]++;
     });
   }
-  return { pixels: n, distinct: counts.size, foreground: fg, foregroundFraction: fg / Math.max(n, 1), colourPixels: hits, grey, blue, magenta,
+  return { pixels: n, distinct: counts.size, foreground: fg, foregroundFraction: fg / Math.max(n, 1), colourPixels: hits, grey, blue, magenta, effector,
            background: bg.map(Math.round) };
 };
 window.regionDiff = async (a, b, rect, pixDiff) => {
@@ -294,6 +300,7 @@ async function main() {
       timeout: { type: "string", default: "120" },
       orbit: { type: "boolean", default: false },
       name: { type: "string" },
+      effectors: { type: "string", default: "0" },
     },
   });
   const name = args.name ?? (args.orbit ? "foxglove-orbit" : "foxglove");
@@ -397,6 +404,13 @@ async function main() {
       const okBody = s3.grey >= minBody;
       console.log(`  [${okBody ? "ok" : "FAIL"}] ${name} body drawn: ${s3.grey} light grey pixels (>= ${minBody})`);
       if (!okBody) problems.push(`${name}: no body in the 3D panel (is /scene drawn?)`);
+      // (a) With --effectors: the effectors (discs of rotors and wheels) are drawn.
+      const minEffector = Number(args.effectors);
+      if (minEffector > 0) {
+        const okEffector = s3.effector >= minEffector;
+        console.log(`  [${okEffector ? "ok" : "FAIL"}] ${name} effectors drawn: ${s3.effector} red pixels (>= ${minEffector})`);
+        if (!okEffector) problems.push(`${name}: no effector (red) in the 3D panel`);
+      }
       // (d) With --orbit: the Earth, the orbit path and the spacecraft marker are drawn.
       if (args.orbit) {
         const so = await stats(shot, orbitPanel.title, [PATH_COLOUR]);

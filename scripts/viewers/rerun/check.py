@@ -19,6 +19,10 @@ it. Against it, this compares what Rerun itself reads (its own chunk readers, `r
   four plots (their series colours over most of the width); with --orbit as well, the orbit
   view under the body's: the Earth (solid blue blocks), the orbit path (its cyan) and the
   spacecraft marker (magenta);
+- with --effectors N, at least N pixels of the effectors' red in the body's view (wheel discs
+  seen through the translucent body);
+- with --omega-decays F, that |ω| at the end of the log is at most F times |ω| at its start
+  (what the ω plot of a detumbling or rate-damping run shows);
 - for a log with the orbit view, the Earth's sphere at the one `/earth` update and the orbit
   path and marker at every `/orbit_scene` update.
 
@@ -278,7 +282,7 @@ ORBIT_VIEW = (0.44, 0.80)
 PATH_RGB = (77, 242, 242)  # the orbit path, (0.3, 0.95, 0.95) in src/log/orbit_scene.rs
 
 
-def check_png(png: Path, orbit: bool = False) -> dict:
+def check_png(png: Path, orbit: bool = False, min_effector: int = 0) -> dict:
     from PIL import Image
 
     print(f"screenshot: {png}")
@@ -314,6 +318,14 @@ def check_png(png: Path, orbit: bool = False) -> dict:
     orange = np.mean((r > 190) & (g > 90) & (g < 190) & (b < 90))
     stats.update(blue_pct=round(100 * blue, 3), orange_pct=round(100 * orange, 3))
     print(f"  info 3D view: H-arrow blue on {100 * blue:.3f}%, omega-arrow orange on {100 * orange:.3f}% of it")
+    if min_effector:
+        # The effectors' red, rgb(217, 51, 64) in src/log/mod.rs, alone or through the body's
+        # translucent grey: red over green, a little blue over green (the omega arrow's orange
+        # has less blue than green).
+        r, g, b = view[..., 0], view[..., 1], view[..., 2]
+        eff = int(((r >= 100) & (r - g >= 12) & (b - g >= 4) & (r - b >= 5)).sum())
+        stats.update(effector_pixels=eff)
+        report(eff >= min_effector, f"3D view: effectors, {eff} pixels of their red (>= {min_effector})")
 
     if orbit:
         ov = region(*ORBIT_VIEW, 0.01, 0.54)
@@ -339,6 +351,17 @@ def check_png(png: Path, orbit: bool = False) -> dict:
     return stats
 
 
+def check_omega_decays(ref: dict, factor: float) -> None:
+    print("omega decays")
+    t, v = ref["series"].get("/telemetry", (None, None))
+    fields = ref["fields"].get("/telemetry", [])
+    if not report(t is not None and len(t) > 1 and "omega_x" in fields, "/telemetry has omega"):
+        return
+    j = fields.index("omega_x")
+    w = np.linalg.norm(v[:, j : j + 3], axis=1)
+    report(w[-1] <= factor * w[0], f"|ω| from {w[0]:.4g} to {w[-1]:.4g} rad/s (<= {factor} of the start)")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("mcap", type=Path)
@@ -347,6 +370,8 @@ def main() -> int:
     ap.add_argument("--fields", type=Path, help="src/log/telemetry.rs, to check FIELDS")
     ap.add_argument("--no-raw", action="store_true", help="skip the raw MCAP through Rerun")
     ap.add_argument("--orbit", action="store_true", help="the screenshot has the orbit view (--png)")
+    ap.add_argument("--effectors", type=int, default=0, help="least pixels of the effectors' red (--png)")
+    ap.add_argument("--omega-decays", type=float, help="|ω| at the end at most this times the start")
     args = ap.parse_args()
     ref = reference(args.mcap)
     if args.fields:
@@ -356,7 +381,9 @@ def main() -> int:
     if args.rrd:
         check_rrd(args.rrd, ref)
     if args.png:
-        check_png(args.png, args.orbit)
+        check_png(args.png, args.orbit, args.effectors)
+    if args.omega_decays is not None:
+        check_omega_decays(ref, args.omega_decays)
     print(f"check: {'FAIL (' + str(len(failures)) + ')' if failures else 'PASS'} {args.mcap.name}")
     return 1 if failures else 0
 

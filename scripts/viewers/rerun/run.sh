@@ -19,6 +19,15 @@
 # cargo exists), OUT (default <repo>/docs/figures/viewing/rerun.png), OUT_ORBIT (default
 # rerun-orbit.png beside OUT), LOGS (work directory, default scripts/viewers/rerun/out),
 # DURATION (default 5), ORBIT_DURATION (default 3400), PYTHON (default python3).
+#
+# ACTUATORS=1 (scripts/viewers/screenshots.sh --actuators): instead of every scenario, the
+# actuator scenes of docs/actuators.md, through the same steps 2 to 4: rwa-rate-damping.yaml
+# (120 s: the four wheel discs drawn, |ω| down to a tenth) and cubesat-detumble.yaml (its 4
+# orbits: the orbit view, and |ω| down to a tenth), written to
+# $OUT_DIR/rerun-rwa-rate-damping.png and $OUT_DIR/rerun-cubesat-detumble.png (OUT_DIR
+# defaults to docs/figures/actuators). The X screen is made wider than the viewer's window
+# there, so that the pointer (at the screen's centre) is off the window and no hover tooltip
+# is drawn over the views.
 set -euo pipefail
 
 here="$(cd -- "$(dirname -- "${BASH_SOURCE[0]}")" && pwd)"
@@ -32,6 +41,17 @@ flagship="explorer1-pydy"
 orbit_flagship="gravity-gradient-smallsat"
 out_orbit="${OUT_ORBIT:-$(dirname "${out}")/rerun-orbit.png}"
 orbit_duration="${ORBIT_DURATION:-3400}"
+actuators="${ACTUATORS:-}"
+out_dir="${OUT_DIR:-${repo}/docs/figures/actuators}"
+xvfb_screen="1920x1200x24"
+# The actuator scenes and their sim durations (empty: the scenario's own).
+declare -A actuator_duration=([rwa-rate-damping]=120 [cubesat-detumble]="")
+if [[ -n "${actuators}" ]]; then
+    xvfb_screen="7200x2000x24"
+fi
+# Largest PNG to keep as it is (bytes; 0: any); a larger one is written with 256 colours.
+max_png=0
+[[ -n "${actuators}" ]] && max_png=399000
 
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 seconds() { local d=$(($(now_ms) - $1)); printf '%d.%01d s' $((d / 1000)) $((d % 1000 / 100)); }
@@ -102,6 +122,9 @@ phase "logs + rerun mcap check"
 mkdir -p "${logs}"
 shopt -s nullglob
 scenarios=("${repo}"/scenarios/*.yaml)
+if [[ -n "${actuators}" ]]; then
+    scenarios=("${repo}/scenarios/rwa-rate-damping.yaml" "${repo}/scenarios/cubesat-detumble.yaml")
+fi
 ((${#scenarios[@]})) || { echo "FAIL: no scenarios in ${repo}/scenarios" >&2; exit 1; }
 names=()
 for s in "${scenarios[@]}"; do
@@ -109,7 +132,9 @@ for s in "${scenarios[@]}"; do
     names+=("$n")
     rm -f "${logs}/${n}.mcap" "${logs}/${n}.rrd" "${logs}/${n}.check.txt"  # no stale results
     args=(run "$s" --out "${logs}/${n}.mcap" --quiet)
-    if [[ "$n" == "${orbit_flagship}" ]]; then
+    if [[ -n "${actuators}" ]]; then
+        [[ -n "${actuator_duration[$n]}" ]] && args+=(--duration "${actuator_duration[$n]}")
+    elif [[ "$n" == "${orbit_flagship}" ]]; then
         args+=(--duration "${orbit_duration}")
     elif [[ "$n" != "${flagship}" ]]; then
         args+=(--duration "${duration}")
@@ -131,7 +156,7 @@ for n in "${names[@]}"; do
     [[ -f "${logs}/${n}.mcap" ]] || continue
     extra=()
     # The flagship's recording is the one shot: start with the time cursor at the end.
-    [[ "$n" == "${flagship}" || "$n" == "${orbit_flagship}" ]] && extra=(--play-state following)
+    [[ "$n" == "${flagship}" || "$n" == "${orbit_flagship}" || -n "${actuators}" ]] && extra=(--play-state following)
     if ! "${py}" "${here}/mcap_to_rrd.py" "${logs}/${n}.mcap" -o "${logs}/${n}.rrd" "${extra[@]}"; then
         fail "convert ${n}"; continue
     fi
@@ -148,6 +173,7 @@ done_phase "convert + verify + check"
 
 # Rerun's own CLI, without the Python SDK: the raw MCAP converted by Rerun has /tf as
 # Transform3D and the telemetry as a decoded message; ours has Transform3D and Scalars.
+if [[ -z "${actuators}" ]]; then
 phase "rerun rrd print"
 flag="${logs}/${flagship}"
 "${rerun}" mcap convert "${flag}.mcap" -o "${flag}.raw.rrd" >/dev/null 2>&1 || fail "rerun mcap convert"
@@ -166,10 +192,15 @@ n_series=$( (grep -o ' - /telemetry/[a-z0-9_]* - data columns: \[Scalars:scalars
     fail "converted: ${n_series} /telemetry series for ${n_fields} FIELDS"
 rm -f "${flag}.raw.rrd"
 done_phase "rerun rrd print"
+fi
 
 # --- 4. headless screenshots ----------------------------------------------------------------
 phase "screenshot"
-mkdir -p "$(dirname "${out}")" "$(dirname "${out_orbit}")"
+if [[ -n "${actuators}" ]]; then
+    mkdir -p "${out_dir}"
+else
+    mkdir -p "$(dirname "${out}")" "$(dirname "${out_orbit}")"
+fi
 xdg="$(mktemp -d)"; chmod 700 "${xdg}"
 # shoot NAME OUT [check.py options]: the recording NAME.rrd on screen, checked, written to OUT.
 shoot() {
@@ -181,7 +212,7 @@ shoot() {
         rm -f "${shot}"
         # --new: a viewer of its own even if one already listens on the default port.
         # RUST_LOG=error: no notification toasts over the views.
-        if XDG_RUNTIME_DIR="${xdg}" RUST_LOG=error timeout 300 xvfb-run -a -s "-screen 0 1920x1200x24" \
+        if XDG_RUNTIME_DIR="${xdg}" RUST_LOG=error timeout 300 xvfb-run -a -s "-screen 0 ${xvfb_screen}" \
             "${rerun}" "${rec}.rrd" --new --bind 127.0.0.1 --renderer vulkan \
             --window-size 1600x1000 --screenshot-to "${shot}" > "${logs}/screenshot.log" 2>&1 &&
             [[ -s "${shot}" ]]; then
@@ -193,7 +224,16 @@ if im.width > 1600: im = im.resize((1600, round(im.height * 1600 / im.width)), I
 im.save(sys.argv[2], optimize=True)' \
                 "${shot}" "${small}"
             if "${py}" "${here}/check.py" "${rec}.mcap" --no-raw --png "${small}" "$@" > "${logs}/${name}.screenshot.check.txt"; then
-                cp "${small}" "${dest}.tmp" && mv "${dest}.tmp" "${dest}"
+                if ((max_png)) && (($(stat -c %s "${small}") > max_png)); then
+                    # Checked in full colour; written with 256 colours to stay under max_png.
+                    "${py}" -c 'import sys; from PIL import Image
+Image.open(sys.argv[1]).quantize(256).save(sys.argv[2], format="PNG", optimize=True)' \
+                        "${small}" "${dest}.tmp"
+                    echo "  $(stat -c %s "${small}") bytes > ${max_png}: written with 256 colours"
+                else
+                    cp "${small}" "${dest}.tmp"
+                fi
+                mv "${dest}.tmp" "${dest}"
                 ok=1; break
             fi
             cat "${logs}/${name}.screenshot.check.txt"
@@ -209,8 +249,13 @@ im.save(sys.argv[2], optimize=True)' \
         fail "screenshot ${name}"
     fi
 }
-shoot "${flagship}" "${out}"
-shoot "${orbit_flagship}" "${out_orbit}" --orbit
+if [[ -n "${actuators}" ]]; then
+    shoot rwa-rate-damping "${out_dir}/rerun-rwa-rate-damping.png" --effectors 1000 --omega-decays 0.1
+    shoot cubesat-detumble "${out_dir}/rerun-cubesat-detumble.png" --orbit --omega-decays 0.1
+else
+    shoot "${flagship}" "${out}"
+    shoot "${orbit_flagship}" "${out_orbit}" --orbit
+fi
 rm -rf "${xdg}"
 done_phase "screenshot"
 
@@ -223,4 +268,9 @@ if ((${#failed[@]})); then
     printf '  %s\n' "${failed[@]}"
     exit 1
 fi
-echo "PASS: ${#names[@]} scenarios logged, checked by Rerun, converted and verified; screenshots ${out}, ${out_orbit}"
+if [[ -n "${actuators}" ]]; then
+    echo "PASS (actuators): ${names[*]} logged, checked by Rerun, converted and verified; screenshots" \
+        "${out_dir}/rerun-rwa-rate-damping.png, ${out_dir}/rerun-cubesat-detumble.png"
+else
+    echo "PASS: ${#names[@]} scenarios logged, checked by Rerun, converted and verified; screenshots ${out}, ${out_orbit}"
+fi
