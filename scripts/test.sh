@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The one test command (README): sets up what the tests need on a fresh machine, then runs
-# the formatter check, clippy and the whole test suite.
+# the formatter check, clippy and the whole test suite, the Python package's included.
 #
 #   scripts/test.sh
 #
@@ -12,8 +12,11 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 scripts/python-venv.sh
 cargo fmt --all -- --check
-cargo clippy --release --all-targets --locked -- -D warnings
+cargo clippy --release --workspace --all-targets --locked -- -D warnings
 cargo test --release --locked --lib --bins --tests
+# The Python package: `pip install ./python` into the venv (sharing target/ with the build
+# above), then its pytest suite against the CLI (docs/python.md).
+scripts/python-package.sh
 # A Monte Carlo campaign as a SLURM job array on a real one-node cluster (installs Debian's
 # slurm-wlm and munge if missing; needs root): the merged shards must equal a single-process
 # run byte for byte (docs/cluster.md).

@@ -1362,7 +1362,10 @@ fn state(o: &crate::model::Observation) -> State {
     }
 }
 
-fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
+/// The `run --summary` JSON document of `outcome` (pretty-printed, newline-terminated): `mcap`
+/// is the log written, if any. Floats are written so that they read back bit for bit. Shared
+/// with the Python package, whose `Result.summary` is this document.
+pub fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
     let summary = Summary {
         polhode_version: env!("CARGO_PKG_VERSION"),
         scenario: &s.name,

@@ -1,0 +1,16 @@
+"""polhode: spacecraft attitude dynamics with energy dissipation, from Python.
+
+Load a scenario (the same YAML files and validation as the ``polhode`` command) and run it::
+
+    import polhode
+    result = polhode.load("scenarios/tennis-racket.yaml").run()
+    result.t, result.omega, result.q      # s; rad/s (body); body->inertial, scalar-first
+    result.events, result.summary         # as `polhode run --summary` reports them
+
+Units are SI (s, rad/s, N m s, J). Quaternions are scalar-first (w, x, y, z) and map body
+vectors to inertial vectors. See docs/python.md.
+"""
+
+from ._polhode import Result, Scenario, ScenarioError, __version__, load, loads
+
+__all__ = ["Result", "Scenario", "ScenarioError", "__version__", "load", "loads"]
