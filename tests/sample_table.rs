@@ -2,6 +2,8 @@
 //! the run's MCAP log by an independent Python reader (tests/python/read_samples.py: the
 //! `mcap` package, the schemas embedded in the log, Python's csv module and pyarrow).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -24,13 +26,7 @@ fn polhode(args: &[&str]) -> std::process::Output {
 }
 
 fn read_samples(log: &Path, csv: &Path, parquet: &Path) -> (bool, String) {
-    let python = root().join(".venv/bin/python");
-    assert!(
-        python.exists(),
-        "{} is missing: run scripts/python-venv.sh (scripts/test.sh does it for you)",
-        python.display()
-    );
-    let o = Command::new(python)
+    let o = Command::new(common::venv_python())
         .arg(root().join("tests/python/read_samples.py"))
         .args([log, csv, parquet])
         .output()

@@ -115,7 +115,7 @@ impl Effector for Magnetorquer {
         WORK
     }
     fn state_names(&self) -> Vec<String> {
-        [
+        super::environment::names(&[
             "dipole_x",
             "dipole_y",
             "dipole_z",
@@ -125,10 +125,7 @@ impl Effector for Magnetorquer {
             "samples",
             "rotation_per_sample",
             "work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
     fn initial_state(&self) -> Vec<f64> {
         vec![0.0; WORK + 1]
@@ -201,7 +198,7 @@ impl Effector for Magnetorquer {
         }
     }
     fn telemetry_names(&self) -> Vec<String> {
-        [
+        super::environment::names(&[
             "dipole_x",
             "dipole_y",
             "dipole_z",
@@ -214,10 +211,7 @@ impl Effector for Magnetorquer {
             "samples",
             "rotation_per_sample",
             "work",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect()
+        ])
     }
     fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
         let b = self.field_at(hub);

@@ -80,3 +80,15 @@ pub fn balance_drift_and_spread(samples: &[Observation]) -> (f64, f64) {
     }
     (worst, (hi - lo) / t0)
 }
+
+/// The Python of the test venv (`.venv`, made by scripts/python-venv.sh), for the independent
+/// readers in tests/python.
+pub fn venv_python() -> std::path::PathBuf {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    assert!(
+        p.exists(),
+        "{} is missing: run scripts/python-venv.sh (scripts/test.sh does it for you)",
+        p.display()
+    );
+    p
+}
