@@ -16,7 +16,8 @@ cargo clippy --release --workspace --all-targets --locked -- -D warnings
 cargo test --release --locked --lib --bins --tests
 # The Python package: `pip install ./python` into the venv (sharing target/ with the build
 # above), then its pytest suite against the CLI (docs/python.md).
-scripts/python-package.sh
+# The binary the tests above just built is the CLI the pytest suite compares against.
+POLHODE_BIN="$PWD/target/release/polhode" scripts/python-package.sh
 # A Monte Carlo campaign as a SLURM job array on a real one-node cluster (installs Debian's
 # slurm-wlm and munge if missing; needs root): the merged shards must equal a single-process
 # run byte for byte (docs/cluster.md).
