@@ -81,11 +81,16 @@ impl Magnetorquer {
         Vector3::new(x[0], x[1], x[2])
     }
 
-    /// The B-dot command (A m², body axes) from the field `b_now` (T, body axes) and the
-    /// previous sample's direction `dir_before` (unit), saturated per axis.
-    pub fn command(&self, b_now: &Vector3<f64>, dir_before: &Vector3<f64>) -> Vector3<f64> {
-        let magnitude = b_now.norm();
-        let dir_rate = (b_now / magnitude - dir_before) / self.clock.period;
+    /// The B-dot command (A m², body axes) from the field's magnitude `magnitude` (T) and
+    /// direction `dir_now` (unit, body axes) now and the previous sample's direction
+    /// `dir_before`, saturated per axis.
+    pub fn command(
+        &self,
+        magnitude: f64,
+        dir_now: &Vector3<f64>,
+        dir_before: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        let dir_rate = (dir_now - dir_before) / self.clock.period;
         let m = -(self.gain / magnitude) * dir_rate;
         Vector3::new(
             m.x.clamp(-self.max_dipole.x, self.max_dipole.x),
@@ -138,12 +143,13 @@ impl Effector for Magnetorquer {
     }
     fn at_breakpoint(&self, hub: &HubState, x: &mut [f64]) {
         let b = self.field_at(hub);
+        let magnitude = b.norm();
+        let dir = b / magnitude;
         let m = if x[6] > 0.0 {
-            self.command(&b, &Vector3::new(x[3], x[4], x[5]))
+            self.command(magnitude, &dir, &Vector3::new(x[3], x[4], x[5]))
         } else {
             Vector3::zeros()
         };
-        let dir = b / b.norm();
         x[..3].copy_from_slice(m.as_slice());
         x[3..6].copy_from_slice(dir.as_slice());
         x[6] += 1.0;

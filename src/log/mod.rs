@@ -100,13 +100,32 @@ struct Channels {
 
 /// A temporary file that is removed when dropped (on errors and panics alike) unless it was
 /// kept by renaming it to its final name.
-struct TempFile {
+pub(crate) struct TempFile {
     path: PathBuf,
     keep: bool,
 }
 
 impl TempFile {
-    fn persist(mut self, to: &Path) -> io::Result<()> {
+    /// Creates the hidden temporary file `.<name>.<pid>.tmp` beside `target` (`name` its
+    /// file name, or `default_name`), in `target`'s directory, which must exist.
+    pub(crate) fn beside(target: &Path, default_name: &str) -> io::Result<(TempFile, File)> {
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let file_name = target
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned())
+            .unwrap_or_else(|| default_name.into());
+        let temp = TempFile {
+            path: dir.join(format!(".{file_name}.{}.tmp", std::process::id())),
+            keep: false,
+        };
+        let file = File::create(&temp.path)?;
+        Ok((temp, file))
+    }
+
+    pub(crate) fn persist(mut self, to: &Path) -> io::Result<()> {
         std::fs::rename(&self.path, to)?;
         self.keep = true;
         Ok(())
@@ -368,15 +387,7 @@ impl<'a> McapLogger<'a> {
         }
         check_replaceable(path)?;
         std::fs::create_dir_all(&dir)?;
-        let file_name = path
-            .file_name()
-            .map(|f| f.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "run.mcap".into());
-        let temp = TempFile {
-            path: dir.join(format!(".{file_name}.{}.tmp", std::process::id())),
-            keep: false,
-        };
-        let file = File::create(&temp.path)?;
+        let (temp, file) = TempFile::beside(path, "run.mcap")?;
         let options = mcap::WriteOptions::new()
             .compression(match scenario.compression {
                 Compression::Lz4 => Some(mcap::Compression::Lz4),

@@ -11,6 +11,7 @@
 //! Both are streamed to a hidden temporary file beside the target and renamed into place
 //! when the run ends, so memory stays flat and a final name never holds a half-written table.
 
+use super::TempFile;
 use super::telemetry::{self, FIELDS};
 use super::units;
 use crate::model::{HubState, Observation, Spacecraft};
@@ -63,48 +64,24 @@ pub fn columns(spacecraft: &Spacecraft) -> Vec<Column> {
     out
 }
 
-/// A file being written beside its target, removed unless renamed into place.
+/// A table being written to a temporary file beside its target.
 struct Pending {
-    tmp: PathBuf,
+    temp: TempFile,
     target: PathBuf,
-    kept: bool,
 }
 
 impl Pending {
     fn new(target: &Path) -> io::Result<(Pending, File)> {
         super::check_replaceable(target)?;
-        let dir = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "table".into());
-        let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-        let file = File::create(&tmp)?;
-        Ok((
-            Pending {
-                tmp,
-                target: target.to_path_buf(),
-                kept: false,
-            },
-            file,
-        ))
+        let (temp, file) = TempFile::beside(target, "table")?;
+        let target = target.to_path_buf();
+        Ok((Pending { temp, target }, file))
     }
 
-    fn persist(mut self) -> io::Result<PathBuf> {
-        std::fs::rename(&self.tmp, &self.target)?;
-        self.kept = true;
-        Ok(self.target.clone())
-    }
-}
-
-impl Drop for Pending {
-    fn drop(&mut self) {
-        if !self.kept {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
+    /// Renames the table into place; returns its path.
+    fn persist(self) -> io::Result<PathBuf> {
+        self.temp.persist(&self.target)?;
+        Ok(self.target)
     }
 }
 
