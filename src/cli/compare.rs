@@ -1,0 +1,102 @@
+//! `polhode compare`: several fidelities of one scene side by side.
+
+use super::{EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_IO, load};
+use crate::log::write_atomically;
+use crate::scenario::{self, Overrides};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Runs each scenario and writes the table, chart, series and JSON asked for.
+pub(super) fn compare_cmd(
+    paths: &[PathBuf],
+    chart: Option<&Path>,
+    csv: Option<&Path>,
+    json: Option<&Path>,
+    duration: Option<f64>,
+    events: &[String],
+) -> i32 {
+    let overrides = Overrides {
+        duration,
+        ..Overrides::default()
+    };
+    // Validate everything before running anything.
+    let mut option_events = Vec::new();
+    for text in events {
+        match scenario::parse_condition(text) {
+            Ok(c) => option_events.push(c),
+            Err(e) => {
+                eprintln!("error: --event '{text}': {e}");
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    let mut scenarios = Vec::new();
+    for p in paths {
+        match load(p, &overrides) {
+            Ok(s) => scenarios.push(s),
+            Err(c) => return c,
+        }
+    }
+    let columns = crate::compare::Columns::new(&scenarios, &option_events);
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
+    let tty = std::io::stderr().is_terminal();
+    let mut rows = Vec::new();
+    let count = scenarios.len();
+    for (i, s) in scenarios.into_iter().enumerate() {
+        if tty {
+            eprintln!("[{}/{count}] {} …", i + 1, s.name);
+        }
+        match crate::compare::run_one(s, &columns, &interrupt) {
+            Ok(r) => rows.push(r),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return EXIT_IO;
+            }
+        }
+        if interrupt.load(Ordering::SeqCst) {
+            eprintln!("interrupted: the table holds the runs finished so far");
+            break;
+        }
+    }
+    let table = crate::compare::table(&rows, &columns);
+    let title = format!(
+        "Nutation angle: {}",
+        rows.iter()
+            .map(|r| r.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" vs ")
+    );
+    let mut outputs: Vec<(&Path, String)> = Vec::new();
+    if let Some(p) = chart {
+        outputs.push((p, crate::compare::chart(&rows, &columns, &title)));
+    }
+    if let Some(p) = csv {
+        outputs.push((p, crate::compare::series_csv(&rows)));
+    }
+    let json_text = serde_json::to_string_pretty(&rows).unwrap_or_default() + "\n";
+    match json {
+        Some(p) if p == Path::new("-") => print!("{json_text}"),
+        Some(p) => outputs.push((p, json_text)),
+        None => {}
+    }
+    for (p, text) in outputs {
+        if let Err(e) = write_atomically(p, text.as_bytes()) {
+            eprintln!("error: cannot write {}: {e}", p.display());
+            return EXIT_IO;
+        }
+    }
+    if json != Some(Path::new("-")) {
+        print!("{table}");
+    }
+    if interrupt.load(Ordering::SeqCst) {
+        EXIT_INTERRUPTED
+    } else {
+        0
+    }
+}

@@ -1,0 +1,244 @@
+//! `polhode run`: one scenario into its log, tables and summary.
+
+use super::summary::{print_summary, summary_json};
+use super::{
+    EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_IO, load, probe_writable, same_file,
+};
+use crate::log::{McapLogger, write_atomically};
+use crate::scenario::Overrides;
+use crate::sim::{self, Control, NullSink, Status};
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// What `polhode run` writes besides its text.
+pub(super) struct RunOutputs<'a> {
+    /// No MCAP log.
+    pub(super) no_log: bool,
+    /// The JSON summary.
+    pub(super) summary: Option<&'a Path>,
+    /// The sampled telemetry as CSV.
+    pub(super) csv: Option<&'a Path>,
+    /// The sampled telemetry as Parquet.
+    pub(super) parquet: Option<&'a Path>,
+}
+
+/// Runs the scenario at `path` with `overrides`, writing `outputs`; returns the exit code.
+pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quiet: bool) -> i32 {
+    let (no_log, summary_path) = (outputs.no_log, outputs.summary);
+    let s = match load(path, overrides) {
+        Ok(s) => s,
+        Err(c) => return c,
+    };
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(p) = summary_path
+        && !no_log
+        && same_file(p, &s.mcap_path)
+    {
+        eprintln!(
+            "error: --summary {} is the log's own path; give the summary another name",
+            p.display()
+        );
+        return EXIT_BAD_INPUT;
+    }
+    if let Some(p) = summary_path
+        && let Err(e) = probe_writable(p)
+    {
+        eprintln!("error: cannot write the summary to {}: {e}", p.display());
+        return EXIT_BAD_INPUT;
+    }
+    // No two outputs may be the same file.
+    let named: Vec<(&str, &Path)> = [
+        ("--summary", summary_path),
+        ("--csv", outputs.csv),
+        ("--parquet", outputs.parquet),
+        ("the log", (!no_log).then_some(s.mcap_path.as_path())),
+    ]
+    .into_iter()
+    .filter_map(|(what, p)| p.map(|p| (what, p)))
+    .collect();
+    for (i, (a, pa)) in named.iter().enumerate() {
+        for (b, pb) in &named[i + 1..] {
+            if same_file(pa, pb) {
+                eprintln!(
+                    "error: {a} and {b} both name {}; give each output its own file",
+                    pa.display()
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    let mut table = if outputs.csv.is_some() || outputs.parquet.is_some() {
+        match crate::log::samples::SampleTable::create(&s.spacecraft, outputs.csv, outputs.parquet)
+        {
+            Ok(t) => Some(t),
+            Err(e) => {
+                eprintln!(
+                    "error: cannot write the sampled telemetry to {}: {e}",
+                    outputs
+                        .csv
+                        .into_iter()
+                        .chain(outputs.parquet)
+                        .map(|p| p.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(" / ")
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    } else {
+        None
+    };
+    let mut logger = if no_log {
+        None
+    } else {
+        match McapLogger::create(&s.mcap_path, &s, s.omega0.norm()) {
+            Ok(l) => Some(l),
+            Err(e) => {
+                eprintln!(
+                    "error: cannot write the log to {}: {e}",
+                    s.mcap_path.display()
+                );
+                return EXIT_BAD_INPUT;
+            }
+        }
+    };
+    if let Some(l) = logger.as_mut() {
+        let estimate_mb = l.estimate_bytes(&s) / 1e6;
+        if estimate_mb > s.max_log_mb {
+            eprintln!(
+                "error: {}: the log would be about {} MB before compression \
+                 ({:.3e} samples at {} Hz over {} s), above the limit of {} MB; lower \
+                 `output.rate` (or `output.scene_rate`), shorten the run, or raise the limit \
+                 with `output.max_log_mb` or --max-log-mb",
+                s.path.display(),
+                match estimate_mb {
+                    x if x >= 100.0 => format!("{x:.0}"),
+                    x if x >= 1.0 => format!("{x:.1}"),
+                    x => format!("{x:.3}"),
+                },
+                (s.duration * s.output_rate).floor() + 1.0,
+                s.output_rate,
+                s.duration,
+                s.max_log_mb
+            );
+            if let Some(l) = logger {
+                l.abandon();
+            }
+            return EXIT_BAD_INPUT;
+        }
+    }
+
+    let interrupt = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupt.clone();
+        // A second Ctrl-C exits at once.
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                std::process::exit(EXIT_INTERRUPTED);
+            }
+        });
+    }
+    let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new((s.duration * 1000.0).ceil() as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} sim {msg} ETA {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let mut progress = |t: f64| {
+        if let Some(b) = &bar {
+            b.set_position((t * 1000.0) as u64);
+            b.set_message(format!("{t:.3}/{} s", s.duration));
+        }
+    };
+    let ctl = Control {
+        interrupt: &interrupt,
+        progress: Some(&mut progress),
+    };
+    let result = match (logger.as_mut(), table.as_mut()) {
+        (Some(l), Some(t)) => sim::run(&s, &mut crate::log::samples::Both(l, t), ctl),
+        (Some(l), None) => sim::run(&s, l, ctl),
+        (None, Some(t)) => sim::run(&s, t, ctl),
+        (None, None) => sim::run(&s, &mut NullSink, ctl),
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let outcome = match result {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: writing the log failed: {e}; no log was kept");
+            if let Some(l) = logger {
+                l.abandon();
+            }
+            return EXIT_IO;
+        }
+    };
+    let mut tables = Vec::new();
+    if let Some(t) = table {
+        match t.finish() {
+            Ok(paths) => tables = paths,
+            Err(e) => {
+                eprintln!("error: finishing the sampled telemetry failed: {e}; no table was kept");
+                if let Some(l) = logger {
+                    l.abandon();
+                }
+                return EXIT_IO;
+            }
+        }
+    }
+    let mut written = None;
+    if let Some(l) = logger {
+        match l.finish(&s, &s.method.describe(), &outcome) {
+            Ok(p) => written = Some(p),
+            Err(e) => {
+                eprintln!(
+                    "error: finishing the log {} failed: {e}; no log was kept",
+                    s.mcap_path.display()
+                );
+                return EXIT_IO;
+            }
+        }
+    }
+    if let Some(p) = summary_path {
+        let json = summary_json(&s, &outcome, written.as_deref());
+        if let Err(e) = write_atomically(p, json.as_bytes()) {
+            eprintln!("error: cannot write the summary {}: {e}", p.display());
+            return EXIT_IO;
+        }
+    }
+    if !quiet {
+        print_summary(&s, &outcome, written.as_deref());
+        for p in &tables {
+            println!("  table: {}", p.display());
+        }
+    }
+    for w in &outcome.warnings {
+        eprintln!("warning: {}", w.message);
+    }
+    match &outcome.status {
+        Status::Complete | Status::Stopped { .. } => 0,
+        Status::Interrupted => {
+            eprintln!(
+                "interrupted at t = {}: the log holds what was computed and is marked partial",
+                crate::timefmt::seconds(outcome.final_observation.t)
+            );
+            EXIT_INTERRUPTED
+        }
+        Status::Failed { diagnosis } => {
+            eprintln!("error: the integration failed: {diagnosis}");
+            EXIT_FAILED
+        }
+        Status::InvalidModel { diagnosis } => {
+            eprintln!("error: the model left its validity range: {diagnosis}");
+            EXIT_FAILED
+        }
+    }
+}
