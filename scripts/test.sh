@@ -14,6 +14,10 @@ scripts/python-venv.sh
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --locked -- -D warnings
 cargo test --release --locked --lib --bins --tests
+# The crate documentation's examples (the typed API's front door), and the documentation
+# itself without a broken link or a missing item.
+cargo test --release --locked --doc
+RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --locked -p polhode
 # The Python package: `pip install ./python` into the venv (sharing target/ with the build
 # above), then its pytest suite against the CLI (docs/python.md).
 # The binary the tests above just built is the CLI the pytest suite compares against.
