@@ -5,13 +5,22 @@
 //! checks physics and ranges, using the spans kept on every checked field, and produces a
 //! [`Scenario`] ready to run.
 
+mod body;
 pub mod campaign;
 mod effectors;
 mod error;
+mod integrator;
 mod orbit;
+mod output;
 mod time;
 
+pub use body::BodySpec;
+use body::ValidHub;
 pub use effectors::{EffectorSpec, HubMotionSpec};
+pub use integrator::IntegratorSpec;
+use integrator::{MethodChoice, from};
+pub use output::{Compression, OutputSpec};
+use output::{OutputSettings, output_rate_hint};
 
 pub use error::{ScenarioError, field_path_at, nearest};
 pub use time::{LAST_LOG_SECOND, format_epoch, log_origin, parse_epoch};
@@ -132,35 +141,6 @@ pub struct DriftBoundsSpec {
     pub quaternion_norm: Option<Spanned<f64>>,
 }
 
-/// `body:` mass properties and display.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BodySpec {
-    /// Hub mass (kg), excluding effectors that move mass; needed when there are such. With
-    /// `composite: true`, the whole spacecraft's mass.
-    #[serde(default)]
-    pub mass: Option<Spanned<f64>>,
-    /// Full inertia tensor about the centre of mass, body axes (kg m², rows). With
-    /// `composite: true`, the whole spacecraft's, effectors at rest, about its centre of mass.
-    #[serde(default)]
-    pub inertia: Option<Spanned<[[f64; 3]; 3]>>,
-    /// Principal moments along body x, y, z (kg m²), instead of `inertia`.
-    #[serde(default)]
-    pub principal: Option<Spanned<[f64; 3]>>,
-    /// Body axis whose angle to H is reported as the nutation angle.
-    #[serde(default)]
-    pub spin_axis: Option<Spanned<[f64; 3]>>,
-    /// Shape drawn in viewers (default: a box with the proportions of the inertia), and
-    /// against which effector placement is checked (not checked without it).
-    #[serde(default)]
-    pub shape: Option<Spanned<ShapeSpec>>,
-    /// The mass properties are the whole spacecraft's (hub, appendages and dampers at rest,
-    /// about the whole spacecraft's centre of mass), as mass-properties reports give them;
-    /// polhode subtracts the effectors at rest to get the hub's own (docs/conventions.md).
-    #[serde(default)]
-    pub composite: Option<Spanned<bool>>,
-}
-
 /// A shape for the 3D view, in body axes, centred on the centre of mass.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
@@ -212,70 +192,6 @@ pub struct QuaternionSpec {
     pub y: f64,
     /// Vector part, z.
     pub z: f64,
-}
-
-/// `integrator:` method and settings.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct IntegratorSpec {
-    /// One of [`Method::NAMES`].
-    #[serde(default)]
-    pub method: Option<Spanned<String>>,
-    /// Fixed step (s), for `rk4`, `gauss`, `lie` and `splitting`.
-    #[serde(default)]
-    pub dt: Option<Spanned<f64>>,
-    /// Relative tolerance, for adaptive methods.
-    #[serde(default)]
-    pub rtol: Option<Spanned<f64>>,
-    /// Absolute tolerance, for adaptive methods.
-    #[serde(default)]
-    pub atol: Option<Spanned<f64>>,
-    /// Largest step (s), for adaptive methods.
-    #[serde(default)]
-    pub max_step: Option<Spanned<f64>>,
-    /// Stages of `gauss`: 1 (implicit midpoint) or 2 (default).
-    #[serde(default)]
-    pub stages: Option<Spanned<u32>>,
-    /// Order of `splitting`: 2 (Strang) or 4 (default).
-    #[serde(default)]
-    pub order: Option<Spanned<u32>>,
-}
-
-/// `output:` sampling and log file.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputSpec {
-    /// Samples per second of sim time (Hz).
-    #[serde(default)]
-    pub rate: Option<Spanned<f64>>,
-    /// MCAP path (relative paths are relative to the working directory).
-    #[serde(default)]
-    pub mcap: Option<Spanned<String>>,
-    /// Largest rate of `/scene` updates (Hz, default 10): the body is drawn at every `/tf`
-    /// sample through its frame; only the ω and H arrows need scene updates.
-    #[serde(default)]
-    pub scene_rate: Option<Spanned<f64>>,
-    /// Chunk compression: `lz4` (default: fast), `zstd` (smaller, ~2× slower to write) or
-    /// `none` (fastest, largest).
-    #[serde(default)]
-    pub compression: Option<Compression>,
-    /// Largest log a run may write (MB = 10⁶ bytes, estimated before the run starts; default
-    /// [`DEFAULT_MAX_LOG_MB`]).
-    #[serde(default)]
-    pub max_log_mb: Option<Spanned<f64>>,
-}
-
-/// MCAP chunk compression.
-#[derive(Debug, Clone, Copy, Default, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub enum Compression {
-    /// LZ4 frames: fast, moderate size.
-    #[default]
-    Lz4,
-    /// Zstandard: smaller files, slower to write.
-    Zstd,
-    /// Uncompressed chunks.
-    None,
 }
 
 /// A condition on a logged quantity, e.g. `{nutation_angle_deg: {above: 89.0}}`.
@@ -899,70 +815,12 @@ impl ScenarioFile {
         }
 
         // Body.
-        let (inertia, inertia_loc, inertia_field) = match (&self.body.inertia, &self.body.principal)
-        {
-            (Some(_), Some(p)) => {
-                return Err(err(
-                    loc(p),
-                    "body.principal",
-                    "give either `inertia` or `principal`, not both".into(),
-                ));
-            }
-            (Some(i), None) => (
-                Matrix3::from_row_slice(&i.value.concat()),
-                loc(i),
-                "body.inertia",
-            ),
-            (None, Some(p)) => (
-                Matrix3::from_diagonal(&Vector3::from(p.value)),
-                loc(p),
-                "body.principal",
-            ),
-            (None, None) => {
-                return Err(err(
-                    key_location(&source, "body"),
-                    "body",
-                    "missing the mass properties: expected `inertia: [[..],[..],[..]]` \
-                     (kg m²) or `principal: [I1, I2, I3]`"
-                        .into(),
-                ));
-            }
-        };
-        let largest = inertia.amax();
-        if largest.is_finite() && !(MIN_POSITIVE..=MAX_MAGNITUDE).contains(&largest) {
-            return Err(err(
-                inertia_loc,
-                inertia_field,
-                format!(
-                    "the largest entry is {largest:e} kg m²; inertia moments must lie from \
-                     {MIN_POSITIVE:e} to {MAX_MAGNITUDE:e} kg m² (SI units: is it in g cm² or \
-                     another unit?)"
-                ),
-            ));
-        }
-        let hub = RigidBody::new(inertia).map_err(|e| {
-            err(
-                inertia_loc,
-                inertia_field,
-                format!("not a physical inertia tensor: {e}"),
-            )
-        })?;
-        let moments = hub.principal_moments;
-        let (smallest, biggest) = (moments.min(), moments.max());
-        if smallest < MIN_MOMENT_RATIO * biggest {
-            return Err(err(
-                inertia_loc,
-                inertia_field,
-                format!(
-                    "principal moments {} kg m²: the smallest is {:.1e} of the largest, below \
-                     the {MIN_MOMENT_RATIO:e} polhode supports (an ideal rod or a body with no \
-                     inertia about an axis cannot be integrated: its rate about that axis is \
-                     undefined)",
-                    [moments[0], moments[1], moments[2]].map(number).join(", "),
-                    smallest / biggest
-                ),
-            ));
-        }
+        let ValidHub {
+            hub,
+            inertia,
+            location: inertia_loc,
+            field: inertia_field,
+        } = self.body.hub(path, &source)?;
 
         // Initial state.
         let omega0 = match (&self.initial.omega, &self.initial.omega_rpm) {
@@ -1058,16 +916,6 @@ impl ScenarioFile {
             None => default_spin_axis(&hub, &omega0),
         };
 
-        // Where a value came from: a command-line option (no line; the option is named) or the
-        // file (its line and field).
-        let from = |option: Option<f64>, l: Option<(u32, u32)>, field: &'static str, flag| {
-            if option.is_some() {
-                (None, flag)
-            } else {
-                (l, field)
-            }
-        };
-
         // Duration.
         let duration = ov.duration.unwrap_or(self.duration.value);
         let (duration_loc, duration_field) =
@@ -1095,312 +943,28 @@ impl ScenarioFile {
 
         // Integrator.
         let spec = self.integrator.unwrap_or_default();
-        let method_loc = spec.method.as_ref().and_then(loc);
-        let method_name = ov
-            .method
-            .clone()
-            .or(spec.method.as_ref().map(|m| m.value.clone()))
-            .unwrap_or_else(|| "dopri5".into());
-        let positive = |v: Option<f64>,
-                        s: &Option<Spanned<f64>>,
-                        field: &'static str,
-                        flag: &'static str,
-                        what: &str| {
-            match v.or(s.as_ref().map(|x| x.value)) {
-                None => Ok(None),
-                Some(x) if x.is_finite() && x > 0.0 => Ok(Some(x)),
-                Some(x) => {
-                    let (l, f) = from(v, s.as_ref().and_then(loc), field, flag);
-                    Err(err(
-                        l,
-                        f,
-                        format!("expected a positive, finite {what}, got {x}"),
-                    ))
-                }
-            }
-        };
-        let dt = positive(ov.dt, &spec.dt, "integrator.dt", "--dt", "step in seconds")?;
-        let rtol = positive(
-            ov.rtol,
-            &spec.rtol,
-            "integrator.rtol",
-            "--rtol",
-            "relative tolerance",
+        let MethodChoice {
+            method,
+            auto,
+            adaptive,
+            location: method_l,
+            field: method_field,
+        } = spec.method(
+            path,
+            ov,
+            (duration, loc(&self.duration)),
+            &omega0,
+            &self.output,
         )?;
-        let atol = positive(
-            ov.atol,
-            &spec.atol,
-            "integrator.atol",
-            "--atol",
-            "absolute tolerance",
-        )?;
-        let max_step = positive(
-            None,
-            &spec.max_step,
-            "integrator.max_step",
-            "integrator.max_step",
-            "step in seconds",
-        )?;
-        let (method_field, method_l) = if ov.method.is_some() {
-            ("--method", None)
-        } else {
-            ("integrator.method", method_loc)
-        };
-        let need_dt = |name: &str| {
-            dt.ok_or_else(|| {
-                err(
-                    method_l,
-                    "integrator.dt",
-                    format!("{name} has a fixed step: expected `dt: <seconds>` (or --dt)"),
-                )
-            })
-        };
-        let adaptive = Adaptive {
-            rtol: rtol.unwrap_or(1e-10),
-            atol: atol.unwrap_or(1e-12),
-            max_step: max_step.unwrap_or(f64::INFINITY),
-        };
-        let choice = |v: Option<u32>,
-                      s: &Option<Spanned<u32>>,
-                      field: &'static str,
-                      flag: &'static str,
-                      allowed: [u32; 2],
-                      default: u32| {
-            let x = v.or(s.as_ref().map(|x| x.value)).unwrap_or(default);
-            if allowed.contains(&x) {
-                Ok(x as u8)
-            } else {
-                let (l, f) = from(v.map(f64::from), s.as_ref().and_then(loc), field, flag);
-                Err(err(
-                    l,
-                    f,
-                    format!("expected {} or {}, got {x}", allowed[0], allowed[1]),
-                ))
-            }
-        };
-        let stages = choice(
-            ov.stages,
-            &spec.stages,
-            "integrator.stages",
-            "--stages",
-            [1, 2],
-            2,
-        )?;
-        let order = choice(
-            ov.order,
-            &spec.order,
-            "integrator.order",
-            "--order",
-            [2, 4],
-            4,
-        )?;
-        // Settings of one method given to another are mistakes, not no-ops.
-        for (given, flag, field, owner) in [
-            (
-                ov.stages.is_some() || spec.stages.is_some(),
-                ov.stages.is_some(),
-                "stages",
-                "gauss",
-            ),
-            (
-                ov.order.is_some() || spec.order.is_some(),
-                ov.order.is_some(),
-                "order",
-                "splitting",
-            ),
-        ] {
-            if given && method_name != owner {
-                let l = if flag {
-                    None
-                } else if field == "stages" {
-                    spec.stages.as_ref().and_then(loc)
-                } else {
-                    spec.order.as_ref().and_then(loc)
-                };
-                let f = match (flag, field) {
-                    (true, "stages") => "--stages",
-                    (true, _) => "--order",
-                    (false, "stages") => "integrator.stages",
-                    (false, _) => "integrator.order",
-                };
-                return Err(err(
-                    l,
-                    f,
-                    format!(
-                        "`{field}` applies to method `{owner}` only, and the method is \
-                         `{method_name}`"
-                    ),
-                ));
-            }
-        }
-        let mut auto = false;
-        let method = match method_name.as_str() {
-            "rk4" => Method::Rk4 {
-                dt: need_dt("rk4")?,
-            },
-            "dopri5" => Method::Dopri5(adaptive),
-            "dop853" => Method::Dop853(adaptive),
-            "radau5" => Method::Radau5(adaptive),
-            "gauss" => Method::Gauss {
-                dt: need_dt("gauss")?,
-                stages,
-            },
-            "lie" => Method::Lie {
-                dt: need_dt("lie")?,
-            },
-            "splitting" => Method::Splitting {
-                dt: need_dt("splitting")?,
-                order,
-            },
-            "exact" => Method::Exact,
-            "auto" => {
-                // Resolved once the spacecraft is built; dop853 stands in for the checks.
-                auto = true;
-                Method::Dop853(adaptive)
-            }
-            other => {
-                let hint = nearest(other, Method::NAMES)
-                    .map(|b| format!("; did you mean `{b}`?"))
-                    .unwrap_or_default();
-                return Err(err(
-                    method_l,
-                    method_field,
-                    format!(
-                        "unknown method `{other}`, expected one of {}{hint}",
-                        Method::NAMES.join(", ")
-                    ),
-                ));
-            }
-        };
-        if let Some(dt) = method.fixed_step()
-            && duration / dt > 1e11
-        {
-            let (l, f) = if ov.dt.is_some() || ov.duration.is_some() {
-                (None, "--dt / --duration")
-            } else {
-                (spec.dt.as_ref().and_then(loc), "integrator.dt")
-            };
-            return Err(err(
-                l,
-                f,
-                format!(
-                    "{:.1e} steps of {dt:e} s over {duration:e} s is too many (limit 1e11)",
-                    duration / dt
-                ),
-            ));
-        }
-        // Bound the work a valid-looking file can ask for.
-        let max_steps = match method {
-            Method::Exact => duration * output_rate_hint(&self.output).max(4.0 * omega0.norm()),
-            m => m.adaptive().map_or(0.0, |a| duration / a.max_step),
-        };
-        if max_steps > 1e11 {
-            let (l, f) = match (&spec.max_step, ov.duration) {
-                (Some(m), _) => (loc(m), "integrator.max_step"),
-                (None, Some(_)) => (None, "--duration"),
-                (None, None) => (loc(&self.duration), "duration"),
-            };
-            return Err(err(
-                l,
-                f,
-                format!(
-                    "the run would need at least {max_steps:.1e} steps; the limit is 1e11 \
-                     (a larger max_step, or a shorter duration)"
-                ),
-            ));
-        }
-        if let Some(Adaptive { rtol, .. }) = method.adaptive()
-            && rtol < 1e-15
-        {
-            let (l, f) = from(
-                ov.rtol,
-                spec.rtol.as_ref().and_then(loc),
-                "integrator.rtol",
-                "--rtol",
-            );
-            return Err(err(
-                l,
-                f,
-                format!("rtol {rtol:e} is below double precision; use at least 1e-15"),
-            ));
-        }
-
-        if let Some(Adaptive { atol, .. }) = method.adaptive()
-            && atol < MIN_ATOL
-        {
-            let (l, f) = from(
-                ov.atol,
-                spec.atol.as_ref().and_then(loc),
-                "integrator.atol",
-                "--atol",
-            );
-            return Err(err(
-                l,
-                f,
-                format!(
-                    "atol {atol:e} is below {MIN_ATOL:e}: the error of a component near zero, \
-                     divided by it, overflows; use at least {MIN_ATOL:e}"
-                ),
-            ));
-        }
 
         // Output.
         let out = self.output.unwrap_or_default();
-        let output_rate = match &out.rate {
-            None => 100.0,
-            Some(r) if r.value.is_finite() && r.value > 0.0 => r.value,
-            Some(r) => {
-                return Err(err(
-                    loc(r),
-                    "output.rate",
-                    format!(
-                        "expected a positive number of samples per second, got {}",
-                        r.value
-                    ),
-                ));
-            }
-        };
-        if duration * output_rate > MAX_SAMPLES {
-            let (l, f) = if ov.duration.is_some() {
-                (None, "--duration")
-            } else {
-                (
-                    out.rate.as_ref().and_then(loc).or(loc(&self.duration)),
-                    "output.rate",
-                )
-            };
-            return Err(err(
-                l,
-                f,
-                format!(
-                    "{:.3e} samples ({duration:e} s at {output_rate:e} Hz) exceed the limit of \
-                     {MAX_SAMPLES:e}; lower the rate or the duration",
-                    duration * output_rate
-                ),
-            ));
-        }
-        let scene_rate = match &out.scene_rate {
-            None => 10.0,
-            Some(r) if r.value.is_finite() && r.value > 0.0 => r.value,
-            Some(r) => {
-                return Err(err(
-                    loc(r),
-                    "output.scene_rate",
-                    format!(
-                        "expected a positive number of updates per second, got {}",
-                        r.value
-                    ),
-                ));
-            }
-        };
-        let mcap_path = match (&ov.mcap, &out.mcap) {
-            (Some(p), _) => p.clone(),
-            (None, Some(p)) if !p.value.trim().is_empty() => PathBuf::from(&p.value),
-            (None, Some(p)) => {
-                return Err(err(loc(p), "output.mcap", "expected a file path".into()));
-            }
-            (None, None) => PathBuf::from(format!("logs/{}.mcap", sanitize(&name))),
-        };
+        let OutputSettings {
+            output_rate,
+            scene_rate,
+            mcap_path,
+            max_log_mb,
+        } = out.settings(path, ov, &name, (duration, loc(&self.duration)))?;
 
         // Epoch.
         let epoch_unix_ns = match &self.epoch {
@@ -1590,25 +1154,6 @@ impl ScenarioFile {
         };
 
         let drift_limits = drift_limits(path, self.checks, &spacecraft)?;
-        let max_log_mb = match (ov.max_log_mb, &out.max_log_mb) {
-            (Some(v), _) if v.is_finite() && v > 0.0 => v,
-            (Some(v), _) => {
-                return Err(err(
-                    None,
-                    "--max-log-mb",
-                    format!("expected a positive number of megabytes, got {v}"),
-                ));
-            }
-            (None, Some(m)) if m.value.is_finite() && m.value > 0.0 => m.value,
-            (None, Some(m)) => {
-                return Err(err(
-                    loc(m),
-                    "output.max_log_mb",
-                    format!("expected a positive number of megabytes, got {}", m.value),
-                ));
-            }
-            (None, None) => DEFAULT_MAX_LOG_MB,
-        };
 
         Ok(Scenario {
             path: path.to_path_buf(),
@@ -1835,27 +1380,6 @@ pub fn choose_method(
             ),
         )
     }
-}
-
-/// The output rate as given (Hz), or the default, before validation (for work estimates).
-fn output_rate_hint(out: &Option<OutputSpec>) -> f64 {
-    out.as_ref()
-        .and_then(|o| o.rate.as_ref())
-        .map(|r| r.value)
-        .filter(|r| r.is_finite() && *r > 0.0)
-        .unwrap_or(100.0)
-}
-
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '-'
-            }
-        })
-        .collect()
 }
 
 /// Parses one condition written like an item of `events:` or `stop:`, e.g.
