@@ -13,7 +13,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 scripts/python-venv.sh
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --locked -- -D warnings
-cargo test --release --locked --lib --bins --tests
+# --workspace: the Python crate's dependencies join the feature resolution, so that
+# `pip install ./python` below reuses this build of the polhode library instead of compiling
+# it again (docs/python.md, "Build time in CI"). --tests covers the library's unit tests
+# (every target with `test = true`); no --lib, which would also build a test harness of the
+# Python crate (`test = false`), linked against libpython.
+cargo test --release --locked --workspace --bins --tests
 # The Python package: `pip install ./python` into the venv (sharing target/ with the build
 # above), then its pytest suite against the CLI (docs/python.md).
 # The binary the tests above just built is the CLI the pytest suite compares against.

@@ -6,10 +6,17 @@ scenario, seed and shard: the extension runs the campaign with the CLI's library
 ``summary.json`` as the CLI would write them; no file is written.
 """
 
+from __future__ import annotations
+
 import json
 import sys
+from typing import TYPE_CHECKING, Any, Callable, Optional, Tuple, Union
 
-from ._polhode import _montecarlo
+from ._polhode import Scenario, _montecarlo
+
+if TYPE_CHECKING:
+    import pandas
+    import pyarrow
 
 __all__ = ["Campaign", "montecarlo"]
 
@@ -37,14 +44,18 @@ class Campaign:
     - ``partial``: whether runs of the range are missing (the campaign was interrupted).
     """
 
-    def __init__(self, parquet, summary, partial):
+    parquet: bytes
+    summary: dict
+    partial: bool
+
+    def __init__(self, parquet: bytes, summary: dict, partial: bool) -> None:
         self.parquet = parquet
         self.summary = summary
         self.partial = partial
         self._table = None
 
     @property
-    def table(self):
+    def table(self) -> pyarrow.Table:
         """The runs as a ``pyarrow.Table`` (pyarrow imported on first use)."""
         if self._table is None:
             pa = _import("pyarrow", "Campaign.table")
@@ -58,20 +69,20 @@ class Campaign:
             self._table = pq.read_table(pa.BufferReader(stream.getvalue()))
         return self._table
 
-    def to_pandas(self):
+    def to_pandas(self) -> pandas.DataFrame:
         """The runs as a pandas DataFrame (needs pyarrow and pandas)."""
         _import("pandas", "Campaign.to_pandas()")
         return self.table.to_pandas()
 
     @property
-    def runs(self):
+    def runs(self) -> int:
         """How many runs finished (rows of the table)."""
         return self.summary["runs_in_table"]
 
-    def __len__(self):
+    def __len__(self) -> int:
         return self.runs
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         partial = ", partial" if self.partial else ""
         return (
             f"Campaign(scenario={self.summary['scenario']!r}, seed={self.summary['seed']}, "
@@ -154,7 +165,14 @@ def _shard(shard):
         raise ValueError(f"shard {shard!r}: expected 'K/N' or (K, N), e.g. '2/8'") from None
 
 
-def montecarlo(scenario, runs=None, seed=None, threads=None, shard=None, progress=None):
+def montecarlo(
+    scenario: Scenario,
+    runs: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    shard: Union[str, Tuple[int, int], None] = None,
+    progress: Union[bool, None, Callable[[int, int], Any]] = None,
+) -> Campaign:
     """Run the scenario's Monte Carlo campaign (its ``montecarlo:`` block) in process.
 
     The same runs, table and summary as ``polhode montecarlo FILE --runs R --seed S
