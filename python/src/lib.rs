@@ -1,12 +1,15 @@
 //! `polhode._polhode`: the Python extension module of polhode (re-exported by the `polhode`
 //! package, `python/polhode/__init__.py`).
 //!
-//! Scenarios are validated by the same loader as the CLI (`polhode::scenario`), and runs go
-//! through the same run loop (`polhode::sim::run`) and the same `--summary` document
-//! (`polhode::cli::summary_json`), so a run from Python gives the CLI's numbers bit for bit.
-//! A run releases the GIL and goes on a worker thread; the calling thread wakes every
-//! [`SIGNAL_POLL`] to check for Ctrl-C, and on one sets the run loop's interrupt flag and
-//! raises `KeyboardInterrupt`. No Rust panic reaches Python: it becomes a `RuntimeError`.
+//! Scenarios are validated by the same loader as the CLI (`polhode::scenario`; a dict is
+//! written out as YAML by `polhode/_dict.py` first), and runs go through the same run loop
+//! (`polhode::sim::run`), the same `--summary` document (`polhode::cli::summary_json`), the
+//! same sample-table columns (`polhode::log::samples::columns`), the same linearisation
+//! (`polhode::cli::linearize_json`) and the same campaign code (`polhode::montecarlo`), so
+//! Python gets the CLI's numbers bit for bit. Long work releases the GIL and goes on a worker
+//! thread; the calling thread wakes every [`SIGNAL_POLL`] to check for Ctrl-C (and to report
+//! a campaign's progress), and on one sets the work's interrupt flag and raises
+//! `KeyboardInterrupt`. No Rust panic reaches Python: it becomes a `RuntimeError`.
 //!
 //! Units are SI throughout (s, rad/s, N m s, J); quaternions are scalar-first `(w, x, y, z)`
 //! and map body vectors to inertial ones (docs/conventions.md).

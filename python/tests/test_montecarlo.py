@@ -162,3 +162,33 @@ def test_the_interpreter_exits_cleanly_after_reading_the_table():
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["5", "5", "5"]
+
+
+def test_the_gil_is_released_during_a_campaign():
+    """Another Python thread keeps running (no gap over 0.25 s) while a campaign goes."""
+    import threading
+
+    import numpy as np
+
+    scenario = polhode.load(SINK)
+    done = threading.Event()
+    outcome = {}
+
+    def work():
+        start = time.perf_counter()
+        outcome["campaign"] = polhode.montecarlo(scenario, runs=300, threads=1, progress=False)
+        outcome["seconds"] = time.perf_counter() - start
+        done.set()
+
+    ticks = []
+    worker = threading.Thread(target=work)
+    worker.start()
+    while not done.is_set():
+        ticks.append(time.perf_counter())
+        sum(i * i for i in range(2000))
+    worker.join()
+    assert outcome["seconds"] > 0.5, "the campaign must last long enough to tell"
+    assert len(ticks) > 10
+    gaps = np.diff(ticks)
+    assert gaps.max() < 0.25, f"this thread stalled {gaps.max():.3f} s during the campaign"
+    assert outcome["campaign"].runs == 300
