@@ -19,6 +19,11 @@ cargo clippy --release --workspace --all-targets --locked -- -D warnings
 # (every target with `test = true`); no --lib, which would also build a test harness of the
 # Python crate (`test = false`), linked against libpython.
 cargo test --release --locked --workspace --bins --tests
+# The crate documentation's examples (the typed API's front door), and the documentation
+# itself without a broken link or a missing item. --workspace for the same features as above
+# (the Python crate has `doctest = false`).
+cargo test --release --locked --workspace --doc
+RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --locked -p polhode
 # The Python package: `pip install ./python` into the venv (sharing target/ with the build
 # above), then its pytest suite against the CLI (docs/python.md).
 # The binary the tests above just built is the CLI the pytest suite compares against.

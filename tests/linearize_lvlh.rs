@@ -17,7 +17,7 @@ mod common;
 
 use common::{run, scenario};
 use nalgebra::{Complex, UnitQuaternion, Vector3};
-use polhode::linearize::lvlh::{LvlhLinearization, linearize_scenario};
+use polhode::linearize::lvlh::{LvlhLinearization, linearize_lvlh};
 use polhode::model::Observation;
 use polhode::sim::Status;
 use std::process::Command;
@@ -67,6 +67,12 @@ fn scene(
 
 /// An inclined, turned orbit so that the LVLH axes are nowhere near the ECI axes.
 const TURNED: &str = ", inclination_deg: 63.4, raan_deg: 40.0, true_anomaly_deg: 25.0";
+
+/// The LVLH linearisation of a loaded scenario (its spacecraft, orbit and initial attitude).
+fn linearize_scenario(s: &polhode::scenario::Scenario) -> Result<LvlhLinearization, String> {
+    let orbit = s.orbit.as_deref().ok_or("no orbit")?;
+    linearize_lvlh(&s.spacecraft, orbit, &s.attitude0)
+}
 
 fn linearize_yaml(yaml: &str) -> Result<LvlhLinearization, String> {
     linearize_scenario(&scenario(yaml))

@@ -100,10 +100,8 @@ fn growth_rate_measured_from_a_flip_matches_k() {
             "",
         ));
         // Sample densely: rate 10 Hz of the helper is too coarse for k = 5 1/s.
-        let s = polhode::scenario::Scenario {
-            output_rate: 50.0 * k,
-            ..s
-        };
+        let mut s = s;
+        s.output_rate = 50.0 * k;
         let (_, rec) = run(&s);
         let window: Vec<(f64, f64)> = rec
             .samples

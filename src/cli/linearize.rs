@@ -29,7 +29,12 @@ impl Analysis {
     /// Linearises `s` the way its kind of scene asks for.
     fn of(s: &Scenario) -> Result<Self, String> {
         if crate::linearize::lvlh::applies(&s.spacecraft) {
-            return crate::linearize::lvlh::linearize_scenario(s).map(Analysis::Lvlh);
+            let orbit = s
+                .orbit
+                .as_deref()
+                .ok_or("the LVLH linearisation needs an `orbit:` block")?;
+            return crate::linearize::lvlh::linearize_lvlh(&s.spacecraft, orbit, &s.attitude0)
+                .map(Analysis::Lvlh);
         }
         if let Some(motion) = s.spacecraft.motion() {
             let omega = motion.omega(s.duration);

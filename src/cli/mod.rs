@@ -1,4 +1,4 @@
-//! The `polhode` command line, one file per command (documented in docs/cli.md): [`run`](run),
+//! The `polhode` command line, one file per command (documented in docs/cli.md): `run`,
 //! `check`, `compare`, `linearize`, `bench`, `montecarlo` and `merge`, `plot`.
 //!
 //! Exit codes: 0 success; 2 bad input (scenario, options, unwritable output; nothing written);

@@ -21,7 +21,6 @@ use super::{central_jacobian, dynamic_states, principal};
 use crate::integrate::OdeSystem;
 use crate::model::{HubState, Spacecraft};
 use crate::orbit::{Lvlh, Orbit};
-use crate::scenario::Scenario;
 use nalgebra::{Complex, DMatrix, Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
 use std::f64::consts::TAU;
 
@@ -120,16 +119,6 @@ pub fn applies(sc: &Spacecraft) -> bool {
     sc.effectors()
         .iter()
         .any(|e| e.kind() == "gravity_gradient")
-}
-
-/// Linearises a loaded scenario (with `orbit:` and `gravity_gradient`) about its LVLH
-/// equilibrium.
-pub fn linearize_scenario(s: &Scenario) -> Result<LvlhLinearization, String> {
-    let orbit = s
-        .orbit
-        .as_deref()
-        .ok_or("the LVLH linearisation needs an `orbit:` block")?;
-    linearize_lvlh(&s.spacecraft, orbit, &s.attitude0)
 }
 
 /// The rigid-body closed forms (Hughes 1986, ch. 9) for moments `[I_roll, I_pitch, I_yaw]`

@@ -12,8 +12,9 @@ mod spec;
 mod summary;
 pub mod table;
 
+pub use crate::scenario::campaign::CampaignFile;
 pub use dispersion::{Dispersion, Distribution, Target, erfc, normal_mass};
-pub use spec::{Campaign, CampaignFile, MAX_RUNS};
+pub use spec::{Campaign, MAX_RUNS};
 pub use summary::{percentile, wilson95};
 pub use table::{Row, RunStatus};
 

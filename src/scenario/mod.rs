@@ -5,6 +5,7 @@
 //! checks physics and ranges, using the spans kept on every checked field, and produces a
 //! [`Scenario`] ready to run.
 
+pub mod campaign;
 mod effectors;
 mod error;
 mod orbit;
@@ -14,8 +15,11 @@ pub use effectors::{EffectorSpec, HubMotionSpec};
 
 pub use error::{ScenarioError, field_path_at, nearest};
 pub use time::{LAST_LOG_SECOND, format_epoch, log_origin, parse_epoch};
+// The run's own types live in `sim`; the loader builds them (re-exported for its users).
+pub use crate::sim::{Adaptive, Condition, DriftLimits, Method, OnBreach, Quantity};
 
 use crate::model::{RigidBody, Spacecraft};
+use crate::sim::Simulation;
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use serde::Deserialize;
 use serde_saphyr::Spanned;
@@ -88,7 +92,7 @@ pub struct ScenarioFile {
     pub hub_motion: Option<HubMotionSpec>,
     /// A Monte Carlo campaign over this scenario (`polhode montecarlo`; ignored by `run`).
     #[serde(default)]
-    pub montecarlo: Option<crate::montecarlo::CampaignFile>,
+    pub montecarlo: Option<campaign::CampaignFile>,
     /// Bounds on invariant drift and what to do when one is exceeded.
     #[serde(default)]
     pub checks: Option<ChecksSpec>,
@@ -126,33 +130,6 @@ pub struct DriftBoundsSpec {
     /// Quaternion norm: ||q| − 1|.
     #[serde(default)]
     pub quaternion_norm: Option<Spanned<f64>>,
-}
-
-/// What the run does when a check fails: an invariant drifts beyond its bound, or an
-/// effector leaves the range its model holds in.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum OnBreach {
-    /// End the run as failed (the log up to there is kept, marked partial).
-    #[default]
-    Stop,
-    /// Print and log a warning once per invariant, and go on.
-    Warn,
-}
-
-/// Bounds on invariant drift checked after every step (`checks:`); `None` is unchecked.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
-pub struct DriftLimits {
-    /// Relative angular-momentum drift bound.
-    pub momentum: Option<f64>,
-    /// Relative energy-balance drift bound.
-    pub energy: Option<f64>,
-    /// Bound on ||q| − 1|.
-    pub quaternion_norm: Option<f64>,
-    /// Stop or warn on drift.
-    pub on_drift: OnBreach,
-    /// Stop or warn when a model leaves its validity range.
-    pub on_validity: OnBreach,
 }
 
 /// `body:` mass properties and display.
@@ -348,231 +325,6 @@ pub struct ThresholdSpec {
     pub hold: Option<f64>,
 }
 
-/// A quantity events can watch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Quantity {
-    /// Nutation angle (degrees).
-    NutationAngleDeg,
-    /// Angle between ω and principal axis 1, 2 or 3 (degrees); the index is 0-based.
-    AngleToPrincipalDeg(usize),
-    /// Body rate component 0, 1 or 2 (rad/s).
-    Omega(usize),
-    /// Kinetic energy (J).
-    KineticEnergy,
-    /// The body's rate |ω| (deg/s).
-    RateDegS,
-}
-
-impl Quantity {
-    /// The YAML key naming it.
-    pub fn key(&self) -> &'static str {
-        match self {
-            Quantity::NutationAngleDeg => "nutation_angle_deg",
-            Quantity::AngleToPrincipalDeg(0) => "angle_to_principal_1_deg",
-            Quantity::AngleToPrincipalDeg(1) => "angle_to_principal_2_deg",
-            Quantity::AngleToPrincipalDeg(_) => "angle_to_principal_3_deg",
-            Quantity::Omega(0) => "omega_x",
-            Quantity::Omega(1) => "omega_y",
-            Quantity::Omega(_) => "omega_z",
-            Quantity::KineticEnergy => "kinetic_energy",
-            Quantity::RateDegS => "rate_deg_s",
-        }
-    }
-
-    /// Its value in an observation.
-    pub fn value(&self, o: &crate::model::Observation) -> f64 {
-        match *self {
-            Quantity::NutationAngleDeg => o.nutation_angle.to_degrees(),
-            Quantity::AngleToPrincipalDeg(i) => o.angles_to_principal[i].to_degrees(),
-            Quantity::Omega(i) => o.omega[i],
-            Quantity::KineticEnergy => o.kinetic_energy,
-            Quantity::RateDegS => o.omega.norm().to_degrees(),
-        }
-    }
-}
-
-/// A validated condition: holds while `sign · (quantity − threshold) > 0`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Condition {
-    /// What is watched.
-    pub quantity: Quantity,
-    /// The threshold, in the quantity's unit.
-    pub threshold: f64,
-    /// `true` for `above`, `false` for `below`.
-    pub above: bool,
-    /// Only the first occurrence is recorded.
-    pub once: bool,
-    /// How long the condition must hold before it counts (s); 0 counts at once.
-    pub hold: f64,
-}
-
-impl Condition {
-    /// Signed distance from the threshold: positive while the condition holds.
-    pub fn margin(&self, o: &crate::model::Observation) -> f64 {
-        let d = self.quantity.value(o) - self.threshold;
-        if self.above { d } else { -d }
-    }
-
-    /// A condition that holds at once, recorded every time it becomes true.
-    pub fn crossing(quantity: Quantity, threshold: f64, above: bool) -> Self {
-        Condition {
-            quantity,
-            threshold,
-            above,
-            once: false,
-            hold: 0.0,
-        }
-    }
-
-    /// Human-readable form, e.g. `nutation_angle_deg above 89`, `nutation_angle_deg below 1
-    /// for 60 s`, `omega_z above 2 once`. Also the key of a campaign's event column.
-    pub fn describe(&self) -> String {
-        let dir = if self.above { "above" } else { "below" };
-        let mut text = format!("{} {dir} {}", self.quantity.key(), self.threshold);
-        if self.hold > 0.0 {
-            text += &format!(" for {} s", self.hold);
-        }
-        if self.once {
-            text += " once";
-        }
-        text
-    }
-}
-
-/// Tolerances and step cap of an adaptive method.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Adaptive {
-    /// Relative tolerance.
-    pub rtol: f64,
-    /// Absolute tolerance.
-    pub atol: f64,
-    /// Largest step (s).
-    pub max_step: f64,
-}
-
-impl Adaptive {
-    fn describe(&self) -> String {
-        let cap = if self.max_step.is_finite() {
-            format!(", max_step {:e} s", self.max_step)
-        } else {
-            String::new()
-        };
-        format!("rtol {:e}, atol {:e}{cap}", self.rtol, self.atol)
-    }
-}
-
-/// The integration method and its settings, validated (see docs/choosing-a-method.md).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Method {
-    /// Classic RK4 with fixed step `dt` (s).
-    Rk4 {
-        /// Step (s).
-        dt: f64,
-    },
-    /// Adaptive Dormand–Prince 5(4).
-    Dopri5(Adaptive),
-    /// Adaptive Dormand–Prince 8(5,3) (Hairer's DOP853).
-    Dop853(Adaptive),
-    /// Adaptive Radau IIA of order 5 (L-stable, implicit): for stiff effectors.
-    Radau5(Adaptive),
-    /// Gauss–Legendre collocation with a fixed step: implicit midpoint (1 stage, order 2) or
-    /// 2 stages (order 4). Keeps every quadratic invariant of the free body.
-    Gauss {
-        /// Step (s).
-        dt: f64,
-        /// Stages: 1 or 2.
-        stages: u8,
-    },
-    /// Runge–Kutta–Munthe-Kaas of order 4 with a fixed step: the attitude advances by
-    /// exponentials, so it stays a unit quaternion.
-    Lie {
-        /// Step (s).
-        dt: f64,
-    },
-    /// Composition of the exact torque-free flow with the flow of the torques and effectors:
-    /// Strang (order 2) or the order-4 triple jump, fixed step.
-    Splitting {
-        /// Step (s).
-        dt: f64,
-        /// Order: 2 or 4.
-        order: u8,
-    },
-    /// Closed-form torque-free solution.
-    Exact,
-}
-
-impl Method {
-    /// Names accepted in YAML and on the command line (`auto` picks one of the others).
-    pub const NAMES: [&'static str; 9] = [
-        "rk4",
-        "dopri5",
-        "dop853",
-        "radau5",
-        "gauss",
-        "lie",
-        "splitting",
-        "exact",
-        "auto",
-    ];
-
-    /// Its name.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::Rk4 { .. } => "rk4",
-            Method::Dopri5(_) => "dopri5",
-            Method::Dop853(_) => "dop853",
-            Method::Radau5(_) => "radau5",
-            Method::Gauss { .. } => "gauss",
-            Method::Lie { .. } => "lie",
-            Method::Splitting { .. } => "splitting",
-            Method::Exact => "exact",
-        }
-    }
-
-    /// Name and settings, e.g. `dopri5 (rtol 1e-10, atol 1e-12)`.
-    pub fn describe(&self) -> String {
-        match self {
-            Method::Rk4 { dt } => format!("rk4 (dt {dt:e} s)"),
-            Method::Dopri5(a) => format!("dopri5 ({})", a.describe()),
-            Method::Dop853(a) => format!("dop853 ({})", a.describe()),
-            Method::Radau5(a) => format!("radau5 ({})", a.describe()),
-            Method::Gauss { dt, stages } => {
-                format!(
-                    "gauss ({stages} stage(s), order {}, dt {dt:e} s)",
-                    2 * stages
-                )
-            }
-            Method::Lie { dt } => format!("lie (RKMK4, dt {dt:e} s)"),
-            Method::Splitting { dt, order } => format!("splitting (order {order}, dt {dt:e} s)"),
-            Method::Exact => "exact (closed-form torque-free solution)".into(),
-        }
-    }
-
-    /// The fixed step (s) of a fixed-step method.
-    pub fn fixed_step(&self) -> Option<f64> {
-        match *self {
-            Method::Rk4 { dt }
-            | Method::Gauss { dt, .. }
-            | Method::Lie { dt }
-            | Method::Splitting { dt, .. } => Some(dt),
-            _ => None,
-        }
-    }
-
-    /// The settings of an adaptive method.
-    pub fn adaptive(&self) -> Option<Adaptive> {
-        match *self {
-            Method::Dopri5(a) | Method::Dop853(a) | Method::Radau5(a) => Some(a),
-            _ => None,
-        }
-    }
-
-    /// Whether the method is implicit (A-stable: no step-size limit from stiffness).
-    pub fn is_implicit(&self) -> bool {
-        matches!(self, Method::Radau5(_) | Method::Gauss { .. })
-    }
-}
-
 /// Shape drawn in viewers, validated.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
@@ -595,7 +347,7 @@ pub enum Shape {
 }
 
 /// `body.composite: true`: the whole spacecraft's mass properties as given, and what polhode
-/// took away to get the hub's own (kept in [`Scenario::spacecraft`]).
+/// took away to get the hub's own (kept in [`Simulation::spacecraft`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompositeHub {
     /// The whole spacecraft's mass as given (kg), if given (it is needed only when effectors
@@ -620,34 +372,21 @@ pub struct Scenario {
     pub source: String,
     /// `name:`.
     pub name: String,
+    /// The run itself: spacecraft, initial state, method, duration, sampling, conditions
+    /// and checks (also reached through `Deref`, as `scenario.spacecraft`).
+    pub simulation: Simulation,
     /// `description:`.
     pub description: String,
     /// Sim time 0 as Unix time (ns; negative before 1970).
     pub epoch_unix_ns: i64,
-    /// The spacecraft (hub and effectors).
-    pub spacecraft: Spacecraft,
-    /// Initial body rates (rad/s).
-    pub omega0: Vector3<f64>,
-    /// Initial attitude, body → inertial.
-    pub attitude0: UnitQuaternion<f64>,
-    /// Simulated time span (s).
-    pub duration: f64,
-    /// Integration method.
-    pub method: Method,
-    /// Why `auto` picked [`Scenario::method`] (None when the method was named).
+    /// Why `auto` picked [`Simulation::method`] (None when the method was named).
     pub method_choice: Option<String>,
-    /// Samples per second of sim time (Hz).
-    pub output_rate: f64,
     /// Where the MCAP log goes.
     pub mcap_path: PathBuf,
     /// Largest rate of `/scene` updates (Hz).
     pub scene_rate: f64,
     /// MCAP chunk compression.
     pub compression: Compression,
-    /// Conditions that end the run.
-    pub stop: Vec<Condition>,
-    /// Conditions that are recorded.
-    pub events: Vec<Condition>,
     /// Shape for viewers.
     pub shape: Shape,
     /// With `body.composite: true`, the whole spacecraft as given and the hub's remainder.
@@ -656,13 +395,26 @@ pub struct Scenario {
     /// printed by `check` and `run`.
     pub warnings: Vec<ScenarioError>,
     /// The `montecarlo:` block as written, checked by `montecarlo::Campaign::new`.
-    pub montecarlo: Option<crate::montecarlo::CampaignFile>,
-    /// Drift bounds checked at every step (`checks:`).
-    pub drift_limits: DriftLimits,
+    pub montecarlo: Option<campaign::CampaignFile>,
     /// Largest log the run may write (MB), checked against an estimate before it starts.
     pub max_log_mb: f64,
     /// The orbit (`orbit:`), when the scenario has one.
     pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
+}
+
+/// A scenario is a [`Simulation`] with the provenance and output settings the YAML front end
+/// adds: it reads as its simulation (`scenario.spacecraft`, `sim::run(&scenario, …)`).
+impl std::ops::Deref for Scenario {
+    type Target = Simulation;
+    fn deref(&self) -> &Simulation {
+        &self.simulation
+    }
+}
+
+impl std::ops::DerefMut for Scenario {
+    fn deref_mut(&mut self) -> &mut Simulation {
+        &mut self.simulation
+    }
 }
 
 /// Overrides from the command line, applied before validation.
@@ -1864,23 +1616,25 @@ impl ScenarioFile {
             name,
             description: self.description.unwrap_or_default(),
             epoch_unix_ns,
-            spacecraft,
-            omega0,
-            attitude0,
-            duration,
-            method,
+            simulation: Simulation {
+                spacecraft,
+                omega0,
+                attitude0,
+                duration,
+                method,
+                output_rate,
+                stop,
+                events,
+                drift_limits,
+            },
             method_choice,
-            output_rate,
             mcap_path,
             scene_rate,
             compression: out.compression.unwrap_or_default(),
-            stop,
-            events,
             shape,
             composite: composite_hub,
             warnings,
             montecarlo: self.montecarlo,
-            drift_limits,
             max_log_mb,
             orbit,
         })

@@ -34,7 +34,7 @@ pub const LAST_LOG_SECOND: u64 = 1 << 32;
 pub const FIRST_EPOCH_YEAR: i64 = 1900;
 
 /// Parses `YYYY-MM-DDTHH:MM:SS[.fraction]Z` (UTC) to Unix time in nanoseconds (negative
-/// before 1970), for years from [`FIRST_EPOCH_YEAR`] until 2106-02-07T06:28:16Z.
+/// before 1970), for years from `FIRST_EPOCH_YEAR` until 2106-02-07T06:28:16Z.
 ///
 /// MCAP log times are unsigned nanoseconds since 1970: a run whose epoch precedes 1970 is
 /// stamped from 1970-01-01T00:00:00Z instead (see [`log_origin`]).

@@ -6,7 +6,7 @@
 //! *known* S seconds later, when the run reaches it). After firing, a condition must stop
 //! holding before it can fire again; with `once: true` it never fires again.
 
-use crate::scenario::Condition;
+use super::Condition;
 
 /// Where a watched condition stands.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,7 +131,7 @@ impl<'a> Watch<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::Quantity;
+    use crate::sim::Quantity;
 
     /// Steps a watch over a sampled margin g(t) on a uniform grid, locating crossings by
     /// linear interpolation.

@@ -5,14 +5,23 @@
 //! sign changes of `Condition::margin`, bracketed at step ends (and at interior points) and
 //! located by the Illinois variant of regula falsi on the dense output.
 
+mod checks;
+mod condition;
 mod events;
-mod methods;
+mod memory;
+mod method;
+mod simulation;
+mod steppers;
 
-pub use methods::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
+pub use checks::{DriftLimits, OnBreach};
+pub use condition::{Condition, Quantity};
+pub use memory::Memory;
+pub use method::{Adaptive, Method};
+pub use simulation::Simulation;
+pub use steppers::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
 
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
-use crate::scenario::{Condition, DriftLimits, Method, OnBreach, Scenario};
 use crate::timefmt::seconds;
 use events::Watch;
 use nalgebra::Vector3;
@@ -180,6 +189,19 @@ pub struct Control<'a> {
     pub progress: Option<&'a mut dyn FnMut(f64)>,
 }
 
+/// The flag behind [`Control::uninterrupted`]: never set.
+static NEVER: AtomicBool = AtomicBool::new(false);
+
+impl Control<'_> {
+    /// No interrupt and no progress display: the run goes to its end.
+    pub fn uninterrupted() -> Control<'static> {
+        Control {
+            interrupt: &NEVER,
+            progress: None,
+        }
+    }
+}
+
 /// Something the run noticed and went on from (e.g. drift beyond a `checks:` bound with
 /// `on_drift: warn`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -219,18 +241,18 @@ pub struct Outcome {
     pub wall_time: f64,
 }
 
-/// Runs `scenario` with its configured method, feeding `sink`.
-pub fn run(scenario: &Scenario, sink: &mut dyn Sink, ctl: Control) -> std::io::Result<Outcome> {
-    let sc = &scenario.spacecraft;
-    let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
-    match AnyStepper::for_scenario(scenario, &y0, true) {
+/// Runs `sim` with its configured method, feeding `sink`.
+pub fn run(sim: &Simulation, sink: &mut dyn Sink, ctl: Control) -> std::io::Result<Outcome> {
+    let sc = &sim.spacecraft;
+    let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
+    match AnyStepper::for_simulation(sim, &y0, true) {
         Ok(stepper) => {
             // Interior event checks where steps can be long (adaptive, implicit, splitting).
-            let interior_checks = match scenario.method {
+            let interior_checks = match sim.method {
                 Method::Rk4 { .. } | Method::Lie { .. } => 0,
                 _ => 3,
             };
-            drive(stepper, scenario, sink, ctl, interior_checks)
+            drive(stepper, sim, sink, ctl, interior_checks)
         }
         Err(diagnosis) => {
             let o = sc.observe(0.0, &y0);
@@ -262,14 +284,14 @@ pub struct Solve {
     pub seconds: f64,
 }
 
-/// Integrates `scenario` from 0 to `t_end` (s) with its method and nothing else: no output
+/// Integrates `sim` from 0 to `t_end` (s) with its method and nothing else: no output
 /// samples, events, invariant tracking or logging (`exact` evaluates the end directly). The
 /// cost of the method alone, for benchmarks (`polhode bench`). `Err` is a diagnosis.
-pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> {
-    let sc = &scenario.spacecraft;
-    let y0 = sc.initial_state(&scenario.omega0, &scenario.attitude0);
+pub fn integrate_only(sim: &Simulation, t_end: f64) -> Result<Solve, String> {
+    let sc = &sim.spacecraft;
+    let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
     let started = Instant::now();
-    let mut stepper = AnyStepper::for_scenario(scenario, &y0, false)?;
+    let mut stepper = AnyStepper::for_simulation(sim, &y0, false)?;
     if let AnyStepper::Exact(exact) = &stepper {
         // The closed form jumps to the end in one evaluation.
         let final_state = exact.state_at(t_end);
@@ -288,7 +310,7 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
         let stop = next_stop(sc, t0, t_end);
         stepper
             .step(sc, stop)
-            .map_err(|e| diagnose(&e.to_string(), t0, stepper.y(), scenario))?;
+            .map_err(|e| diagnose(&e.to_string(), t0, stepper.y(), sim))?;
         if stepper.t() == stop && stop < t_end {
             let mut y = stepper.y().to_vec();
             sc.at_breakpoint(stop, &mut y);
@@ -303,7 +325,7 @@ pub fn integrate_only(scenario: &Scenario, t_end: f64) -> Result<Solve, String> 
             // Without dense output only the step's ends can be read: report the start.
             let mut buf = vec![0.0; y0.len()];
             stepper.interpolate(stepper.t_prev(), &mut buf);
-            return Err(diagnose(&what, stepper.t_prev(), &buf, scenario));
+            return Err(diagnose(&what, stepper.t_prev(), &buf, sim));
         }
     }
     let seconds = started.elapsed().as_secs_f64();
@@ -324,7 +346,7 @@ pub const DIVERGENCE_ENERGY_REL: f64 = 0.5;
 /// event that fires every period of a very long run cannot use unbounded memory.
 pub const MAX_EVENTS_KEPT: usize = 10_000;
 
-/// A run whose average step, over two consecutive windows of [`COLLAPSE_WINDOW`] steps, is
+/// A run whose average step, over two consecutive windows of `COLLAPSE_WINDOW` steps, is
 /// so small that its whole duration would take more than this many steps stops as failed
 /// (the bound the scenario checks put on the work a file may ask for): a singularity of the
 /// model, or stiffness an explicit method crawls through.
@@ -348,15 +370,15 @@ const POLL_STEPS: u64 = 64;
 
 fn drive<M: Stepper>(
     mut stepper: M,
-    scenario: &Scenario,
+    sim: &Simulation,
     sink: &mut dyn Sink,
     mut ctl: Control,
     interior_checks: usize,
 ) -> std::io::Result<Outcome> {
     let started = Instant::now();
-    let sc = &scenario.spacecraft;
-    let t_end = scenario.duration;
-    let rate = scenario.output_rate;
+    let sc = &sim.spacecraft;
+    let t_end = sim.duration;
+    let rate = sim.output_rate;
     let n = sc.dim();
     let mut buf = vec![0.0; n];
 
@@ -368,14 +390,14 @@ fn drive<M: Stepper>(
     let mut warnings: Vec<Warning> = Vec::new();
     // Invariants already warned about (momentum, energy, quaternion norm).
     let mut warned = [false; 3];
-    let limits = scenario.drift_limits;
+    let limits = sim.drift_limits;
     let mut window = (0u64, 0.0f64);
     let mut collapsed_windows = 0u32;
-    let mut watches: Vec<Watch> = scenario
+    let mut watches: Vec<Watch> = sim
         .stop
         .iter()
         .map(|c| Watch::new(c, true))
-        .chain(scenario.events.iter().map(|c| Watch::new(c, false)))
+        .chain(sim.events.iter().map(|c| Watch::new(c, false)))
         .collect();
     // Effectors whose models have a validity range, and how far each has been reported
     // (0: not yet, 1: warned, 2: warned past the limit).
@@ -416,7 +438,7 @@ fn drive<M: Stepper>(
     // A model already outside its range at t = 0.
     if status.is_none()
         && let Some(s) = check_validity(
-            scenario,
+            sim,
             &ranged,
             &mut validity_reported,
             0.0,
@@ -462,7 +484,7 @@ fn drive<M: Stepper>(
         let stop = next_stop(sc, t0, t_end);
         if let Err(e) = stepper.step(sc, stop) {
             status = Some(Status::Failed {
-                diagnosis: diagnose(&e.to_string(), t0, stepper.y(), scenario),
+                diagnosis: diagnose(&e.to_string(), t0, stepper.y(), sim),
             });
             break;
         }
@@ -480,7 +502,7 @@ fn drive<M: Stepper>(
                 seconds(t1)
             );
             status = Some(Status::Failed {
-                diagnosis: diagnose(&what, t_good, &buf, scenario),
+                diagnosis: diagnose(&what, t_good, &buf, sim),
             });
             last_good = Some(t_good);
             break;
@@ -494,12 +516,12 @@ fn drive<M: Stepper>(
                 seconds(t1)
             );
             status = Some(Status::Failed {
-                diagnosis: diagnose(&what, t1, stepper.y(), scenario),
+                diagnosis: diagnose(&what, t1, stepper.y(), sim),
             });
             break;
         }
         if let Some((which, what)) = drift_excess(&limits, &drift, &warned, t1) {
-            let message = drift_message(&what, t1, stepper.y(), scenario);
+            let message = drift_message(&what, t1, stepper.y(), sim);
             match limits.on_drift {
                 OnBreach::Stop => {
                     status = Some(Status::Failed { diagnosis: message });
@@ -530,7 +552,7 @@ fn drive<M: Stepper>(
                     COLLAPSE_WINDOW
                 );
                 status = Some(Status::Failed {
-                    diagnosis: diagnose(&what, t1, stepper.y(), scenario),
+                    diagnosis: diagnose(&what, t1, stepper.y(), sim),
                 });
                 break;
             }
@@ -538,7 +560,7 @@ fn drive<M: Stepper>(
         }
         if !ranged.is_empty()
             && let Some(s) = check_validity(
-                scenario,
+                sim,
                 &ranged,
                 &mut validity_reported,
                 t1,
@@ -772,16 +794,16 @@ fn stability_bound(m: &Method) -> Option<f64> {
 
 /// A diagnosis for a failed integration: what, when, the state, the suspected cause and what
 /// to try.
-pub fn diagnose(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
+pub fn diagnose(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
     let state = hub_state_text(y);
     // `t` and `y` are the last finite state known: how stiff are the equations there?
-    let sc = &scenario.spacecraft;
+    let sc = &sim.spacecraft;
     let stiffness = y
         .iter()
         .all(|v| v.is_finite())
-        .then(|| crate::linearize::stiffness(sc, t, y, scenario.duration));
+        .then(|| crate::linearize::stiffness(sc, t, y, sim.duration));
     let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
-    let m = &scenario.method;
+    let m = &sim.method;
     let (cause, remedy) = if let Some(found) = model_outside_range(sc, y) {
         found
     } else {
@@ -876,8 +898,8 @@ fn drift_excess(
 }
 
 /// Time, state and what to do about drift beyond a bound.
-fn drift_message(what: &str, t: f64, y: &[f64], scenario: &Scenario) -> String {
-    let m = &scenario.method;
+fn drift_message(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
+    let m = &sim.method;
     let remedy = match (m.fixed_step(), m.adaptive()) {
         (Some(dt), _) => format!(
             "a smaller step (dt is {dt:e} s; the drift of an order-p method shrinks as dt^p), \
@@ -924,7 +946,7 @@ fn model_outside_range(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
 /// `checks.on_validity: warn`); past a limit under `stop`, returns the invalid-model status.
 #[allow(clippy::too_many_arguments)]
 fn check_validity(
-    scenario: &Scenario,
+    sim: &Simulation,
     ranged: &[usize],
     reported: &mut [u8],
     t: f64,
@@ -932,7 +954,7 @@ fn check_validity(
     sink: &mut dyn Sink,
     warnings: &mut Vec<Warning>,
 ) -> std::io::Result<Option<Status>> {
-    let sc = &scenario.spacecraft;
+    let sc = &sim.spacecraft;
     for &k in ranged {
         let e = &sc.effectors()[k];
         let x = sc.effector_states(k, y);
@@ -950,7 +972,7 @@ fn check_validity(
             continue;
         }
         let (state, remedy) = e.validity_report(x);
-        let stop = level == 2 && scenario.drift_limits.on_validity == OnBreach::Stop;
+        let stop = level == 2 && sim.drift_limits.on_validity == OnBreach::Stop;
         if stop {
             return Ok(Some(Status::InvalidModel {
                 diagnosis: format!(

@@ -3,27 +3,12 @@
 
 use polhode::model::Observation;
 use polhode::scenario::{self, Overrides, Scenario};
-use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink};
+use polhode::sim::{self, Control, Outcome};
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// A sink that keeps every sample and event in memory.
-#[derive(Default)]
-pub struct Recorder {
-    pub samples: Vec<Observation>,
-    pub events: Vec<EventRecord>,
-}
-
-impl Sink for Recorder {
-    fn sample(&mut self, o: &Observation, _y: &[f64], _inv: &Reference) -> std::io::Result<()> {
-        self.samples.push(o.clone());
-        Ok(())
-    }
-    fn event(&mut self, e: &EventRecord, _o: &Observation) -> std::io::Result<()> {
-        self.events.push(e.clone());
-        Ok(())
-    }
-}
+pub type Recorder = polhode::sim::Memory;
 
 /// Parses a scenario from YAML text.
 pub fn scenario(yaml: &str) -> Scenario {

@@ -9,13 +9,13 @@
 //! - [`SplittingStepper`]: compositions of the exact torque-free flow with the flow of
 //!   everything else (torques, effectors), of order 2 (Strang) and 4 (triple jump).
 
+use super::{Adaptive, Method, Simulation};
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{
     Dop853, Dopri5, FixedGrid, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError,
     Stepper, Tolerances,
 };
 use crate::model::Spacecraft;
-use crate::scenario::{Method, Scenario};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
 /// Any of polhode's methods behind one type, so the run loop is compiled once.
@@ -44,13 +44,13 @@ impl AnyStepper {
     /// the method cannot treat this spacecraft. Without `dense_output`, a method may skip
     /// the work that only interpolation needs (dop853's three extra stages), and then
     /// `interpolate` is valid at the step's ends only.
-    pub fn for_scenario(
-        scenario: &Scenario,
+    pub fn for_simulation(
+        sim: &Simulation,
         y0: &[f64],
         dense_output: bool,
     ) -> Result<Self, String> {
-        let sc = &scenario.spacecraft;
-        let tol = |a: crate::scenario::Adaptive| {
+        let sc = &sim.spacecraft;
+        let tol = |a: Adaptive| {
             (
                 Tolerances {
                     rtol: a.rtol,
@@ -59,7 +59,7 @@ impl AnyStepper {
                 a.max_step,
             )
         };
-        Ok(match scenario.method {
+        Ok(match sim.method {
             Method::Rk4 { dt } => AnyStepper::Rk4(Rk4::new(0.0, y0, dt)),
             Method::Dopri5(a) => {
                 let (t, m) = tol(a);
@@ -85,7 +85,7 @@ impl AnyStepper {
             Method::Splitting { dt, order } => {
                 AnyStepper::Splitting(SplittingStepper::new(sc, 0.0, y0, dt, order)?)
             }
-            Method::Exact => AnyStepper::Exact(ExactStepper::new(sc, y0, scenario.output_rate)?),
+            Method::Exact => AnyStepper::Exact(ExactStepper::new(sc, y0, sim.output_rate)?),
         })
     }
 }
