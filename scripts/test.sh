@@ -13,10 +13,16 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 scripts/python-venv.sh
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --locked -- -D warnings
-cargo test --release --locked --lib --bins --tests
+# --workspace: the Python crate's dependencies join the feature resolution, so that
+# `pip install ./python` below reuses this build of the polhode library instead of compiling
+# it again (docs/python.md, "Build time in CI"). --tests covers the library's unit tests
+# (every target with `test = true`); no --lib, which would also build a test harness of the
+# Python crate (`test = false`), linked against libpython.
+cargo test --release --locked --workspace --bins --tests
 # The crate documentation's examples (the typed API's front door), and the documentation
-# itself without a broken link or a missing item.
-cargo test --release --locked --doc
+# itself without a broken link or a missing item. --workspace for the same features as above
+# (the Python crate has `doctest = false`).
+cargo test --release --locked --workspace --doc
 RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --locked -p polhode
 # The Python package: `pip install ./python` into the venv (sharing target/ with the build
 # above), then its pytest suite against the CLI (docs/python.md).

@@ -6,11 +6,26 @@ Load a scenario (the same YAML files and validation as the ``polhode`` command) 
     result = polhode.load("scenarios/tennis-racket.yaml").run()
     result.t, result.omega, result.q      # s; rad/s (body); body->inertial, scalar-first
     result.events, result.summary         # as `polhode run --summary` reports them
+    result.telemetry                      # the columns of `polhode run --csv`, by name
+
+A scenario can also come from a dict (``Scenario.from_dict``); ``montecarlo`` runs its
+campaign (``Campaign.table`` is a pyarrow Table equal to the CLI's ``runs.parquet``).
 
 Units are SI (s, rad/s, N m s, J). Quaternions are scalar-first (w, x, y, z) and map body
 vectors to inertial vectors. See docs/python.md.
 """
 
-from ._polhode import Result, Scenario, ScenarioError, __version__, load, loads
+from ._campaign import Campaign, montecarlo
+from ._polhode import Result, Scenario, ScenarioError, __version__, linearize, load, loads
 
-__all__ = ["Result", "Scenario", "ScenarioError", "__version__", "load", "loads"]
+__all__ = [
+    "Campaign",
+    "Result",
+    "Scenario",
+    "ScenarioError",
+    "__version__",
+    "linearize",
+    "load",
+    "loads",
+    "montecarlo",
+]

@@ -1,7 +1,7 @@
 """Type stubs of the extension module polhode._polhode (re-exported by polhode)."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -36,7 +36,13 @@ class Result:
         """Attitude quaternion body->inertial, scalar-first (w, x, y, z), shape (n, 4)."""
     @property
     def telemetry(self) -> Dict[str, npt.NDArray[np.float64]]:
-        """Every ``/telemetry`` field of the MCAP log by name (units in docs/logs.md), shape (n,)."""
+        """The columns of ``polhode run --csv`` by name, each of shape (n,).
+
+        Every ``/telemetry`` field of the MCAP log (``sim_time`` s, ``omega_x`` rad/s,
+        ``h_norm`` N m s, ``kinetic_energy`` J, ``nutation_angle_deg`` deg, ...; units in
+        docs/logs.md), then each effector's fields as ``<effector>.<field>``
+        (``wheel.rate`` rad/s, ``damper.offset`` m, ...). Views of one buffer, no copy.
+        """
     @property
     def events(self) -> List[Dict[str, Any]]:
         """Events in time order: ``t`` (s), ``condition`` (str), ``terminal`` (bool)."""
@@ -46,6 +52,11 @@ class Result:
     @property
     def status(self) -> str:
         """complete, stopped, interrupted, failed or invalid_model."""
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame``: ``t`` (s), then every ``telemetry`` column (same units).
+
+        Imports pandas (not a dependency of polhode; ImportError saying so when missing).
+        """
 
 class Scenario:
     """A validated scenario."""
@@ -64,7 +75,18 @@ class Scenario:
         """The integration method's name (for ``auto``, the one it picked)."""
     @property
     def source(self) -> str:
-        """The YAML text."""
+        """The YAML text (for :meth:`from_dict`, the text written from the dict)."""
+    @staticmethod
+    def from_dict(d: Mapping[str, Any]) -> "Scenario":
+        """Validate a scenario given as a dict, as the YAML file would read.
+
+        Values: dicts, lists/tuples, numbers, text, booleans, None; numpy arrays and scalars
+        are taken as lists and numbers. SI units, as in the files (s, rad/s, kg m^2, ...).
+        Validated by the CLI's loader; ``ScenarioError`` with ``path="<dict>"``, ``field``
+        the dotted field (``body.inertia``, ``effectors[0].mass``), ``line``/``column``
+        None, for wrong types, NaN/inf, unknown keys, wrong shapes and values YAML cannot
+        hold (sets, objects).
+        """
     def run(
         self,
         method: Optional[str] = None,
@@ -82,6 +104,26 @@ class Scenario:
         Raises ScenarioError when an override does not validate, OSError when the log
         cannot be written.
         """
+
+def linearize(scenario: Scenario) -> Dict[str, Any]:
+    """The JSON of ``polhode linearize FILE --json OUT`` as a dict (docs/linearize.md).
+
+    Modes about the steady spin (eigenvalues in 1/s, time constants in s), or about the LVLH
+    equilibrium for a gravity-gradient spacecraft in orbit, or the effectors' modes under a
+    driven hub. Raises ScenarioError, or ValueError with the CLI's message when the scenario
+    cannot be linearised.
+    """
+
+def _montecarlo(
+    scenario: Scenario,
+    runs: Optional[int] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    on_progress: Optional[Callable[[int, int], object]] = None,
+) -> Tuple[bytes, str, bool, Optional[BaseException]]:
+    """Internal: see :func:`polhode.montecarlo`. Returns the ``runs.parquet`` bytes, the
+    ``summary.json`` text, whether runs are missing, and the exception raised meanwhile."""
 
 def load(path: Union[str, "PathLike[str]"]) -> Scenario:
     """Read and validate a scenario file (YAML); raises ScenarioError."""

@@ -1,29 +1,33 @@
 //! `polhode._polhode`: the Python extension module of polhode (re-exported by the `polhode`
 //! package, `python/polhode/__init__.py`).
 //!
-//! Scenarios are validated by the same loader as the CLI (`polhode::scenario`), and runs go
-//! through the same run loop (`polhode::sim::run`) and the same `--summary` document
-//! (`polhode::cli::summary_json`), so a run from Python gives the CLI's numbers bit for bit.
-//! A run releases the GIL and goes on a worker thread; the calling thread wakes every
-//! [`SIGNAL_POLL`] to check for Ctrl-C, and on one sets the run loop's interrupt flag and
-//! raises `KeyboardInterrupt`. No Rust panic reaches Python: it becomes a `RuntimeError`.
+//! Scenarios are validated by the same loader as the CLI (`polhode::scenario`; a dict is
+//! written out as YAML by `polhode/_dict.py` first), and runs go through the same run loop
+//! (`polhode::sim::run`), the same `--summary` document (`polhode::cli::summary_json`), the
+//! same sample-table columns (`polhode::log::samples::columns`), the same linearisation
+//! (`polhode::cli::linearize_json`) and the same campaign code (`polhode::montecarlo`), so
+//! Python gets the CLI's numbers bit for bit. Long work releases the GIL and goes on a worker
+//! thread; the calling thread wakes every [`SIGNAL_POLL`] to check for Ctrl-C (and to report
+//! a campaign's progress), and on one sets the work's interrupt flag and raises
+//! `KeyboardInterrupt`. No Rust panic reaches Python: it becomes a `RuntimeError`.
 //!
 //! Units are SI throughout (s, rad/s, N m s, J); quaternions are scalar-first `(w, x, y, z)`
 //! and map body vectors to inertial ones (docs/conventions.md).
 
 use numpy::{IntoPyArray, PyArrayMethods};
-use polhode::log::{McapLogger, telemetry};
-use polhode::model::Observation;
+use polhode::log::{McapLogger, samples, telemetry};
+use polhode::model::{HubState, Observation, Spacecraft};
+use polhode::montecarlo;
 use polhode::scenario::{self, Overrides};
 use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Warning};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyImportError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBytes, PyDict, PyList, PySlice};
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
@@ -32,6 +36,9 @@ const SIGNAL_POLL: Duration = Duration::from_millis(100);
 
 /// The name a scenario given as text (`loads`) goes by in messages and `ScenarioError.path`.
 const TEXT_SOURCE_NAME: &str = "<string>";
+
+/// The name a scenario given as a dict (`Scenario.from_dict`) goes by.
+const DICT_SOURCE_NAME: &str = "<dict>";
 
 create_exception!(
     polhode,
@@ -132,31 +139,90 @@ fn loads(py: Python<'_>, yaml_text: String) -> PyResult<PyScenario> {
     validate(py, Path::new(TEXT_SOURCE_NAME), Some(yaml_text))
 }
 
-/// Keeps every output sample's telemetry (column by column) and forwards everything to the
-/// MCAP log when there is one.
+/// Output samples stored column-major in one buffer: column k holds `cap` slots starting at
+/// `k * cap`, of which the first `len` are filled. Handed to numpy as one `(width, n)` array
+/// whose rows are the columns, so the telemetry, `t`, `omega` and `q` are views of a single
+/// allocation, made by Rust and owned by numpy without a copy.
+struct ColumnStore {
+    width: usize,
+    cap: usize,
+    len: usize,
+    data: Vec<f64>,
+}
+
+/// Samples reserved up front at most; a longer run grows the buffer by doubling.
+const MAX_RESERVED_SAMPLES: usize = 1 << 21;
+
+impl ColumnStore {
+    /// Room for `samples` samples (at most [`MAX_RESERVED_SAMPLES`]); the zeroed buffer is
+    /// committed by the OS page by page as samples arrive.
+    fn new(width: usize, samples: usize) -> Self {
+        let cap = samples.clamp(1, MAX_RESERVED_SAMPLES);
+        ColumnStore {
+            width,
+            cap,
+            len: 0,
+            data: vec![0.0; width * cap],
+        }
+    }
+
+    fn push(&mut self, row: &[f64]) {
+        if self.len == self.cap {
+            let cap = self.cap * 2;
+            let mut data = vec![0.0; self.width * cap];
+            for k in 0..self.width {
+                data[k * cap..k * cap + self.len]
+                    .copy_from_slice(&self.data[k * self.cap..k * self.cap + self.len]);
+            }
+            self.data = data;
+            self.cap = cap;
+        }
+        for (k, v) in row.iter().take(self.width).enumerate() {
+            self.data[k * self.cap + self.len] = *v;
+        }
+        self.len += 1;
+    }
+
+    /// The filled columns back to back (`width * len` values), the buffer shrunk to fit.
+    fn into_columns(mut self) -> Vec<f64> {
+        if self.len < self.cap {
+            for k in 1..self.width {
+                let from = k * self.cap;
+                self.data.copy_within(from..from + self.len, k * self.len);
+            }
+            self.data.truncate(self.width * self.len);
+            self.data.shrink_to_fit();
+        }
+        self.data
+    }
+}
+
+/// Keeps every output sample's telemetry and effector fields (the columns of
+/// `polhode run --csv`) and forwards everything to the MCAP log when there is one.
 struct Collector<'a> {
-    /// One column per [`telemetry::FIELDS`] entry, one value per sample.
-    columns: Vec<Vec<f64>>,
-    /// Body rates (rad/s), three per sample, row-major.
-    omega: Vec<f64>,
-    /// Attitude quaternion body→inertial, scalar-first, four per sample, row-major.
-    q: Vec<f64>,
+    spacecraft: &'a Spacecraft,
+    store: ColumnStore,
+    /// The current sample's values (scratch).
+    row: Vec<f64>,
     /// The log, when `log=` names one.
     log: Option<McapLogger<'a>>,
 }
 
-/// Column indices of the body rates and of the quaternion in [`telemetry::FIELDS`].
-const OMEGA_COLUMNS: std::ops::Range<usize> = 1..4;
-const Q_COLUMNS: std::ops::Range<usize> = 4..8;
-
 impl Sink for Collector<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()> {
-        let values = telemetry::values(o, inv);
-        for (column, value) in self.columns.iter_mut().zip(values) {
-            column.push(value);
+        // The same values, in the same order, as the sample tables (polhode::log::samples).
+        self.row.clear();
+        self.row.extend_from_slice(&telemetry::values(o, inv));
+        let hub = HubState {
+            t: o.t,
+            omega: o.omega,
+            attitude: &y[3..7],
+        };
+        for (k, e) in self.spacecraft.effectors().iter().enumerate() {
+            self.row
+                .extend(e.telemetry(&hub, self.spacecraft.effector_states(k, y)));
         }
-        self.omega.extend_from_slice(&values[OMEGA_COLUMNS]);
-        self.q.extend_from_slice(&values[Q_COLUMNS]);
+        self.store.push(&self.row);
         match self.log.as_mut() {
             Some(log) => log.sample(o, y, inv),
             None => Ok(()),
@@ -180,9 +246,12 @@ impl Sink for Collector<'_> {
 
 /// What a finished run hands back to the calling thread.
 struct Products {
-    columns: Vec<Vec<f64>>,
-    omega: Vec<f64>,
-    q: Vec<f64>,
+    /// Column names: the `/telemetry` fields, then `<effector>.<field>`.
+    names: Vec<String>,
+    /// The columns back to back, `n` values each.
+    columns: Vec<f64>,
+    /// Output samples.
+    n: usize,
     outcome: Outcome,
     summary_json: String,
 }
@@ -228,10 +297,16 @@ fn execute(
     } else {
         None
     };
+    let names: Vec<String> = samples::columns(&s.spacecraft)
+        .into_iter()
+        .map(|c| c.name)
+        .collect();
+    // Samples at k / rate up to the end, and the last instant.
+    let expected = (s.duration * s.output_rate).floor().max(0.0) as usize + 2;
     let mut collector = Collector {
-        columns: vec![Vec::new(); telemetry::FIELDS.len()],
-        omega: Vec::new(),
-        q: Vec::new(),
+        spacecraft: &s.spacecraft,
+        store: ColumnStore::new(names.len(), expected),
+        row: Vec::with_capacity(names.len()),
         log: logger,
     };
     let control = Control {
@@ -257,23 +332,33 @@ fn execute(
         None => None,
     };
     let summary_json = polhode::cli::summary_json(&s, &outcome, written.as_deref());
+    let n = collector.store.len;
     Ok(Products {
-        columns: collector.columns,
-        omega: collector.omega,
-        q: collector.q,
+        names,
+        columns: collector.store.into_columns(),
+        n,
         outcome,
         summary_json,
     })
 }
 
+/// How a detached piece of work ended: its value (or the panic that stopped it), and the
+/// exception raised on the calling thread meanwhile (Ctrl-C's `KeyboardInterrupt`, or one
+/// from `on_wake`), after which the work was told to stop and then waited for.
+struct Detached<T> {
+    value: Result<T, Box<dyn Any + Send>>,
+    raised: Option<PyErr>,
+}
+
 /// Runs `work` on a worker thread with the GIL released, waking every [`SIGNAL_POLL`] to run
-/// Python's signal handlers; on an exception from them (Ctrl-C: `KeyboardInterrupt`) sets
-/// `interrupt`, waits for the worker to stop and returns the exception.
+/// Python's signal handlers and then `on_wake`; on an exception from either (Ctrl-C:
+/// `KeyboardInterrupt`) sets `interrupt` and waits for the worker to stop.
 fn run_detached<T: Send>(
     py: Python<'_>,
     interrupt: &AtomicBool,
+    mut on_wake: impl FnMut(Python<'_>) -> PyResult<()>,
     work: impl FnOnce() -> T + Send,
-) -> PyResult<Result<T, Box<dyn Any + Send>>> {
+) -> Detached<T> {
     let finished = (Mutex::new(false), Condvar::new());
     std::thread::scope(|scope| {
         let worker = scope.spawn(|| {
@@ -291,26 +376,60 @@ fn run_detached<T: Send>(
                 .unwrap_or_else(|p| p.into_inner());
             *guard
         };
-        let mut signal = None;
+        let mut raised = None;
         while !py.detach(wait) {
-            if let Err(e) = py.check_signals() {
+            if let Err(e) = py.check_signals().and_then(|()| on_wake(py)) {
                 interrupt.store(true, Ordering::SeqCst);
-                signal = Some(e);
+                raised = Some(e);
                 break;
             }
         }
         // The worker ends soon after the flag is set (after the current step).
-        let result = py.detach(|| worker.join());
-        let result = result.unwrap_or_else(Err);
-        match signal {
-            Some(e) => Err(e),
-            None => Ok(result),
+        let value = py.detach(|| worker.join());
+        Detached {
+            value: value.unwrap_or_else(Err),
+            raised,
         }
     })
 }
 
 #[pymethods]
 impl PyScenario {
+    /// Validates a scenario given as a dict (as the YAML file would read: nested dicts, lists,
+    /// numbers, text, booleans; numpy arrays and scalars are taken as lists and numbers).
+    ///
+    /// The dict is written out as YAML text (non-finite floats as `.nan`, `.inf`) and goes
+    /// through the CLI's loader, so the checks and messages are the CLI's. On an error,
+    /// `ScenarioError.path` is `<dict>`, `.field` the dotted path of the field
+    /// (`body.inertia`, `effectors[0].mass`) and `.line`/`.column` None (the text they would
+    /// point into is generated). A value of a type YAML has no word for (a set, an object)
+    /// raises `ScenarioError` naming its field too.
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, d: &Bound<'_, PyAny>) -> PyResult<PyScenario> {
+        let written = py.import("polhode._dict")?.call_method1("to_yaml", (d,))?;
+        let (text, fields): (String, Vec<Option<String>>) = written.extract()?;
+        let defaults = Overrides::default();
+        let parsed = catch_unwind(AssertUnwindSafe(|| {
+            scenario::parse(Path::new(DICT_SOURCE_NAME), text, &defaults)
+        }))
+        .map_err(|p| internal_error("validating the scenario", p.as_ref()))?;
+        match parsed {
+            Ok(s) => Ok(PyScenario::from_core(s)),
+            Err(mut e) => {
+                if e.field.is_none() {
+                    // The key on the line the loader points at (an unknown key, say).
+                    e.field = e
+                        .line
+                        .and_then(|l| fields.get((l as usize).checked_sub(1)?).cloned())
+                        .flatten();
+                }
+                e.line = None;
+                e.column = None;
+                Err(scenario_error(py, &e))
+            }
+        }
+    }
+
     /// `name:` of the scenario.
     #[getter]
     fn name(&self) -> &str {
@@ -382,10 +501,16 @@ impl PyScenario {
         };
         let interrupt = AtomicBool::new(false);
         let (path, source) = (self.path.clone(), self.source.clone());
-        let result = run_detached(py, &interrupt, || {
-            execute(&path, source, &overrides, write_log, &interrupt)
-        })?;
-        let products = match result {
+        let detached = run_detached(
+            py,
+            &interrupt,
+            |_| Ok(()),
+            || execute(&path, source, &overrides, write_log, &interrupt),
+        );
+        if let Some(e) = detached.raised {
+            return Err(e);
+        }
+        let products = match detached.value {
             Ok(Ok(p)) => p,
             Ok(Err(RunError::Scenario(e))) => return Err(scenario_error(py, &e)),
             Ok(Err(RunError::LogTooLarge(m))) => return Err(PyValueError::new_err(m)),
@@ -399,6 +524,10 @@ impl PyScenario {
 }
 
 /// The result of `Scenario.run`: arrays over the output samples, events and the summary.
+///
+/// Every array is a view of one `(columns, n)` float64 buffer filled by the run and handed to
+/// numpy without a copy: `telemetry[name]` is a row of it, `t` the `sim_time` row, `omega`
+/// and `q` the transposed `omega_*` and `q_*` rows.
 #[pyclass(frozen, module = "polhode", name = "Result")]
 struct RunResult {
     /// Sim time of each output sample (s), shape (n,).
@@ -410,7 +539,8 @@ struct RunResult {
     /// Attitude quaternion body→inertial, scalar-first (w, x, y, z), shape (n, 4).
     #[pyo3(get)]
     q: Py<PyAny>,
-    /// Every `/telemetry` field of the MCAP log by name, each an array of shape (n,).
+    /// Every `/telemetry` field of the MCAP log, then every effector's fields as
+    /// `<effector>.<field>` (the columns of `polhode run --csv`), each of shape (n,).
     #[pyo3(get)]
     telemetry: Py<PyDict>,
     /// Events in time order: dicts with `t` (s), `condition` and `terminal`.
@@ -424,15 +554,25 @@ struct RunResult {
     status: String,
 }
 
+/// Rows of the `omega_*` and `q_*` columns in [`telemetry::FIELDS`].
+const OMEGA_ROWS: (usize, usize) = (1, 4);
+const Q_ROWS: (usize, usize) = (4, 8);
+
 impl RunResult {
     fn new(py: Python<'_>, p: Products) -> PyResult<Self> {
-        let n = p.columns.first().map_or(0, Vec::len);
-        let t = p.columns[0].clone().into_pyarray(py);
-        let omega = p.omega.into_pyarray(py).reshape([n, 3])?;
-        let q = p.q.into_pyarray(py).reshape([n, 4])?;
+        let block = p.columns.into_pyarray(py).reshape([p.names.len(), p.n])?;
+        let block = block.as_any();
+        let rows_t = |(a, b): (usize, usize)| -> PyResult<Bound<'_, PyAny>> {
+            block
+                .get_item(PySlice::new(py, a as isize, b as isize, 1))?
+                .getattr("T")
+        };
+        let t = block.get_item(0)?;
+        let omega = rows_t(OMEGA_ROWS)?;
+        let q = rows_t(Q_ROWS)?;
         let telemetry = PyDict::new(py);
-        for (name, column) in telemetry::FIELDS.iter().zip(p.columns) {
-            telemetry.set_item(name, column.into_pyarray(py))?;
+        for (k, name) in p.names.iter().enumerate() {
+            telemetry.set_item(name, block.get_item(k)?)?;
         }
         let events = PyList::empty(py);
         for e in &p.outcome.events {
@@ -446,15 +586,34 @@ impl RunResult {
             .import("json")?
             .call_method1("loads", (p.summary_json,))?;
         Ok(RunResult {
-            t: t.into_any().unbind(),
-            omega: omega.into_any().unbind(),
-            q: q.into_any().unbind(),
+            t: t.unbind(),
+            omega: omega.unbind(),
+            q: q.unbind(),
             telemetry: telemetry.unbind(),
             events: events.unbind(),
             summary: summary.unbind(),
             status: p.outcome.status.label().to_string(),
         })
     }
+}
+
+/// `module`, imported, or an `ImportError` saying what needs it and how to install it.
+fn import_optional<'py>(
+    py: Python<'py>,
+    module: &str,
+    what: &str,
+) -> PyResult<Bound<'py, PyModule>> {
+    py.import(module).map_err(|e| {
+        if e.is_instance_of::<PyImportError>(py) {
+            PyImportError::new_err(format!(
+                "{what} needs {module}, which is not installed: `pip install {module}` \
+                 ({})",
+                e.value(py)
+            ))
+        } else {
+            e
+        }
+    })
 }
 
 #[pymethods]
@@ -467,6 +626,138 @@ impl RunResult {
             self.events.bind(py).len()
         )
     }
+
+    /// A pandas DataFrame: `t` (s), then every column of `telemetry` (units as there).
+    ///
+    /// pandas is imported here (not a dependency of polhode): `ImportError` when missing.
+    /// The DataFrame holds a copy of the arrays.
+    fn to_pandas(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let pandas = import_optional(py, "pandas", "Result.to_pandas()")?;
+        let data = PyDict::new(py);
+        data.set_item("t", self.t.bind(py))?;
+        for (name, column) in self.telemetry.bind(py).iter() {
+            data.set_item(name, column)?;
+        }
+        Ok(pandas.getattr("DataFrame")?.call1((data,))?.unbind())
+    }
+}
+
+/// The linearisation `polhode linearize FILE --json OUT` writes, as a dict (its JSON text
+/// parsed by Python's `json`): the modes about the steady spin, or about the LVLH
+/// equilibrium for a gravity-gradient spacecraft in orbit, or the effectors' modes under a
+/// driven hub (docs/linearize.md has the fields and units).
+///
+/// Raises `ScenarioError` when the scenario no longer validates, `ValueError` with the CLI's
+/// message when it cannot be linearised.
+#[pyfunction]
+fn linearize(py: Python<'_>, scenario: PyRef<'_, PyScenario>) -> PyResult<Py<PyAny>> {
+    let (path, source) = (scenario.path.clone(), scenario.source.clone());
+    let analysed = catch_unwind(AssertUnwindSafe(|| {
+        scenario::parse(&path, source, &Overrides::default())
+            .map(|s| polhode::cli::linearize_json(&s))
+    }))
+    .map_err(|p| internal_error("linearising the scenario", p.as_ref()))?;
+    let json = match analysed {
+        Err(e) => return Err(scenario_error(py, &e)),
+        Ok(Err(m)) => {
+            return Err(PyValueError::new_err(format!("{}: {m}", path.display())));
+        }
+        Ok(Ok(json)) => json,
+    };
+    Ok(py.import("json")?.call_method1("loads", (json,))?.unbind())
+}
+
+/// Runs a Monte Carlo campaign in process (`polhode.montecarlo` wraps it): the runs of the
+/// range, the `runs.parquet` bytes and `summary.json` text `polhode montecarlo` writes for
+/// them, whether runs are missing, and the exception raised meanwhile (Ctrl-C), if any.
+/// `on_progress(done, total)` is called from this thread: once before, then on the 0.1 s
+/// wake-ups when the count changed, and once at the end.
+#[pyfunction]
+#[pyo3(signature = (scenario, runs=None, seed=None, threads=None, shard=None, on_progress=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn _montecarlo(
+    py: Python<'_>,
+    scenario: PyRef<'_, PyScenario>,
+    runs: Option<u64>,
+    seed: Option<u64>,
+    threads: Option<usize>,
+    shard: Option<(u64, u64)>,
+    on_progress: Option<Bound<'_, PyAny>>,
+) -> PyResult<(Py<PyBytes>, String, bool, Option<Py<PyAny>>)> {
+    let (path, source) = (scenario.path.clone(), scenario.source.clone());
+    let prepared = catch_unwind(AssertUnwindSafe(|| {
+        let s = scenario::parse(&path, source, &Overrides::default())?;
+        montecarlo::Prepared::new(s, &path.display().to_string(), runs, seed)
+    }))
+    .map_err(|p| internal_error("preparing the campaign", p.as_ref()))?;
+    let prep = prepared.map_err(|e| scenario_error(py, &e))?;
+    let total_runs = prep.campaign.runs;
+    if let Some((k, n)) = shard {
+        if k == 0 || k > n {
+            return Err(PyValueError::new_err(format!(
+                "shard {k}/{n}: expected K/N with 1 <= K <= N, e.g. 2/8"
+            )));
+        }
+        if n > total_runs {
+            return Err(PyValueError::new_err(format!(
+                "shard: {n} shards for {total_runs} runs would leave some empty; use at most \
+                 {total_runs} shards"
+            )));
+        }
+    }
+    let threads = match threads {
+        Some(0) => return Err(PyValueError::new_err("threads: expected at least 1")),
+        Some(t) => t,
+        None => std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
+    };
+    let range = match shard {
+        Some((k, n)) => montecarlo::shard_range(total_runs, k, n),
+        None => 0..total_runs,
+    };
+    let total = range.end - range.start;
+    let done = AtomicU64::new(0);
+    let mut shown = None;
+    let mut report = |_py: Python<'_>| -> PyResult<()> {
+        let now = done.load(Ordering::Relaxed);
+        match &on_progress {
+            Some(f) if shown != Some(now) => {
+                shown = Some(now);
+                f.call1((now, total)).map(|_| ())
+            }
+            _ => Ok(()),
+        }
+    };
+    report(py)?;
+    let interrupt = AtomicBool::new(false);
+    let on_row = |_: &montecarlo::Row| {
+        done.fetch_add(1, Ordering::Relaxed);
+    };
+    let detached = run_detached(py, &interrupt, &mut report, || {
+        prep.execute(range, threads, &interrupt, &on_row)
+    });
+    let (rows, partial) = match detached.value {
+        Ok(Ok(x)) => x,
+        Ok(Err(m)) => return Err(PyRuntimeError::new_err(m)),
+        Err(panic) => return Err(internal_error("running the campaign", panic.as_ref())),
+    };
+    let raised = detached.raised.map(|e| e.into_value(py).into_any());
+    if raised.is_none() {
+        report(py)?;
+    }
+    let shard = shard.map(|(k, n)| [k, n]);
+    let tables = catch_unwind(AssertUnwindSafe(|| {
+        let parquet = montecarlo::table::to_parquet(&prep.columns, &rows)?;
+        let summary = montecarlo::output::summary_json(&prep, &rows, shard, partial)?;
+        Ok::<_, String>((parquet, summary))
+    }))
+    .map_err(|p| internal_error("writing the campaign's table", p.as_ref()))?;
+    let (parquet, summary) = tables.map_err(PyRuntimeError::new_err)?;
+    Ok((
+        PyBytes::new(py, &parquet).unbind(),
+        summary,
+        partial,
+        raised,
+    ))
 }
 
 /// polhode's simulator: `load`/`loads` a scenario, `Scenario.run` it.
@@ -474,6 +765,8 @@ impl RunResult {
 fn _polhode(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(loads, m)?)?;
+    m.add_function(wrap_pyfunction!(_montecarlo, m)?)?;
+    m.add_function(wrap_pyfunction!(linearize, m)?)?;
     m.add_class::<PyScenario>()?;
     m.add_class::<RunResult>()?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;

@@ -168,10 +168,6 @@ pub fn write_outputs(
 ) -> Result<Written, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     clear_outputs(dir)?;
-    let range = match shard {
-        Some([k, n]) => shard_range(prep.campaign.runs, k, n),
-        None => 0..prep.campaign.runs,
-    };
     let mut written = Vec::new();
     let put = |written: &mut Vec<PathBuf>, name: &str, bytes: &[u8]| -> Result<(), String> {
         let p = dir.join(name);
@@ -191,21 +187,7 @@ pub fn write_outputs(
         "scenario.yaml",
         prep.scenario.source.as_bytes(),
     )?;
-    let manifest = Manifest {
-        format: MANIFEST_FORMAT.into(),
-        polhode_version: env!("CARGO_PKG_VERSION").into(),
-        build_id: BUILD_ID.into(),
-        scenario: prep.scenario.name.clone(),
-        scenario_sha256: prep.scenario_sha256.clone(),
-        seed: prep.campaign.seed,
-        runs: prep.campaign.runs,
-        shard,
-        run_range: [range.start, range.end],
-        runs_in_table: rows.len() as u64,
-        partial,
-        columns: prep.columns.clone(),
-        runs_csv_sha256: sha256_hex(csv.as_bytes()),
-    };
+    let manifest = manifest(prep, rows, shard, partial, &csv);
     let plan = chart_plan(prep, rows, shard);
     let doc = summary_doc(prep, rows, &manifest, plan);
     let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
@@ -233,6 +215,51 @@ pub fn write_outputs(
         files: written,
         mcap_interrupted,
     })
+}
+
+/// The manifest of `rows` (`csv`: their `runs.csv` text).
+fn manifest(
+    prep: &Prepared,
+    rows: &[Row],
+    shard: Option<[u64; 2]>,
+    partial: bool,
+    csv: &str,
+) -> Manifest {
+    let range = match shard {
+        Some([k, n]) => shard_range(prep.campaign.runs, k, n),
+        None => 0..prep.campaign.runs,
+    };
+    Manifest {
+        format: MANIFEST_FORMAT.into(),
+        polhode_version: env!("CARGO_PKG_VERSION").into(),
+        build_id: BUILD_ID.into(),
+        scenario: prep.scenario.name.clone(),
+        scenario_sha256: prep.scenario_sha256.clone(),
+        seed: prep.campaign.seed,
+        runs: prep.campaign.runs,
+        shard,
+        run_range: [range.start, range.end],
+        runs_in_table: rows.len() as u64,
+        partial,
+        columns: prep.columns.clone(),
+        runs_csv_sha256: sha256_hex(csv.as_bytes()),
+    }
+}
+
+/// The text of `summary.json` that [`write_outputs`] would write for `rows`, without writing
+/// anything (for callers that keep the campaign in memory, e.g. the Python package). Its
+/// `charts` name the files `write_outputs` would draw.
+pub fn summary_json(
+    prep: &Prepared,
+    rows: &[Row],
+    shard: Option<[u64; 2]>,
+    partial: bool,
+) -> Result<String, String> {
+    let csv = table::to_csv(&prep.columns, rows);
+    let manifest = manifest(prep, rows, shard, partial, &csv);
+    let plan = chart_plan(prep, rows, shard);
+    let doc = summary_doc(prep, rows, &manifest, plan);
+    Ok(serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n")
 }
 
 fn summary_doc<'a>(

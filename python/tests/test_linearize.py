@@ -1,0 +1,43 @@
+"""polhode.linearize against `polhode linearize FILE --json OUT`."""
+
+import json
+import subprocess
+
+import pytest
+
+import polhode
+from conftest import REPO
+
+# A spinner with a damper (modes about the steady spin), a gravity-gradient spacecraft in
+# orbit (about its LVLH equilibrium), a driven hub (the effectors' modes), a rigid body.
+SCENARIOS = [
+    "scenarios/nutation-damper.yaml",
+    "scenarios/gravity-gradient-smallsat.yaml",
+    "scenarios/spin-up.yaml",
+    "scenarios/tennis-racket.yaml",
+]
+
+
+@pytest.mark.parametrize("scenario", SCENARIOS)
+def test_linearize_equals_the_cli_json(polhode_cli, tmp_path, scenario):
+    out = tmp_path / "linearization.json"
+    subprocess.run(
+        [str(polhode_cli), "linearize", str(REPO / scenario), "--json", str(out)],
+        check=True,
+        capture_output=True,
+    )
+    expected = json.loads(out.read_text())
+    got = polhode.linearize(polhode.load(REPO / scenario))
+    assert isinstance(got, dict) and got
+    assert got == expected
+
+
+def test_linearize_a_scenario_from_text_and_from_a_dict():
+    text = (REPO / "scenarios/nutation-damper.yaml").read_text()
+    from_file = polhode.linearize(polhode.load(REPO / "scenarios/nutation-damper.yaml"))
+    assert polhode.linearize(polhode.loads(text)) == from_file
+
+
+def test_linearize_wants_a_scenario():
+    with pytest.raises(TypeError):
+        polhode.linearize("scenarios/nutation-damper.yaml")
