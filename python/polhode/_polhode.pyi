@@ -106,7 +106,7 @@ class Scenario:
         """
 
 def linearize(scenario: Scenario) -> Dict[str, Any]:
-    """The JSON of ``polhode linearize FILE --json OUT`` as a dict (docs/linearize.md).
+    """The JSON of ``polhode linearize FILE --json OUT`` as a dict (docs/cli.md).
 
     Modes about the steady spin (eigenvalues in 1/s, time constants in s), or about the LVLH
     equilibrium for a gravity-gradient spacecraft in orbit, or the effectors' modes under a

@@ -1,0 +1,107 @@
+//! `Result`: a run's arrays (views of one Rust-owned buffer), events and summary.
+
+use crate::errors::import_optional;
+use crate::run::Products;
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PySlice};
+
+/// The result of `Scenario.run`: arrays over the output samples, events and the summary.
+///
+/// Every array is a view of one `(columns, n)` float64 buffer filled by the run and handed to
+/// numpy without a copy: `telemetry[name]` is a row of it, `t` the `sim_time` row, `omega`
+/// and `q` the transposed `omega_*` and `q_*` rows.
+#[pyclass(frozen, module = "polhode", name = "Result")]
+pub(crate) struct RunResult {
+    /// Sim time of each output sample (s), shape (n,).
+    #[pyo3(get)]
+    pub(crate) t: Py<PyAny>,
+    /// Body rates (rad/s, body frame), shape (n, 3).
+    #[pyo3(get)]
+    pub(crate) omega: Py<PyAny>,
+    /// Attitude quaternion body→inertial, scalar-first (w, x, y, z), shape (n, 4).
+    #[pyo3(get)]
+    pub(crate) q: Py<PyAny>,
+    /// Every `/telemetry` field of the MCAP log, then every effector's fields as
+    /// `<effector>.<field>` (the columns of `polhode run --csv`), each of shape (n,).
+    #[pyo3(get)]
+    pub(crate) telemetry: Py<PyDict>,
+    /// Events in time order: dicts with `t` (s), `condition` and `terminal`.
+    #[pyo3(get)]
+    pub(crate) events: Py<PyList>,
+    /// The `polhode run --summary` document, as a dict.
+    #[pyo3(get)]
+    pub(crate) summary: Py<PyAny>,
+    /// How the run ended: complete, stopped, interrupted, failed or invalid_model.
+    #[pyo3(get)]
+    pub(crate) status: String,
+}
+
+/// Rows of the `omega_*` and `q_*` columns in [`telemetry::FIELDS`].
+pub(crate) const OMEGA_ROWS: (usize, usize) = (1, 4);
+pub(crate) const Q_ROWS: (usize, usize) = (4, 8);
+
+impl RunResult {
+    pub(crate) fn new(py: Python<'_>, p: Products) -> PyResult<Self> {
+        let block = p.columns.into_pyarray(py).reshape([p.names.len(), p.n])?;
+        let block = block.as_any();
+        let rows_t = |(a, b): (usize, usize)| -> PyResult<Bound<'_, PyAny>> {
+            block
+                .get_item(PySlice::new(py, a as isize, b as isize, 1))?
+                .getattr("T")
+        };
+        let t = block.get_item(0)?;
+        let omega = rows_t(OMEGA_ROWS)?;
+        let q = rows_t(Q_ROWS)?;
+        let telemetry = PyDict::new(py);
+        for (k, name) in p.names.iter().enumerate() {
+            telemetry.set_item(name, block.get_item(k)?)?;
+        }
+        let events = PyList::empty(py);
+        for e in &p.outcome.events {
+            let event = PyDict::new(py);
+            event.set_item("t", e.t)?;
+            event.set_item("condition", &e.condition)?;
+            event.set_item("terminal", e.terminal)?;
+            events.append(event)?;
+        }
+        let summary = py
+            .import("json")?
+            .call_method1("loads", (p.summary_json,))?;
+        Ok(RunResult {
+            t: t.unbind(),
+            omega: omega.unbind(),
+            q: q.unbind(),
+            telemetry: telemetry.unbind(),
+            events: events.unbind(),
+            summary: summary.unbind(),
+            status: p.outcome.status.label().to_string(),
+        })
+    }
+}
+
+#[pymethods]
+impl RunResult {
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let n = self.t.bind(py).len().unwrap_or(0);
+        format!(
+            "Result(status={:?}, samples={n}, events={})",
+            self.status,
+            self.events.bind(py).len()
+        )
+    }
+
+    /// A pandas DataFrame: `t` (s), then every column of `telemetry` (units as there).
+    ///
+    /// pandas is imported here (not a dependency of polhode): `ImportError` when missing.
+    /// The DataFrame holds a copy of the arrays.
+    fn to_pandas(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let pandas = import_optional(py, "pandas", "Result.to_pandas()")?;
+        let data = PyDict::new(py);
+        data.set_item("t", self.t.bind(py))?;
+        for (name, column) in self.telemetry.bind(py).iter() {
+            data.set_item(name, column)?;
+        }
+        Ok(pandas.getattr("DataFrame")?.call1((data,))?.unbind())
+    }
+}

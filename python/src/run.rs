@@ -1,0 +1,212 @@
+//! One run on a worker thread: the samples collected column by column into one buffer, the
+//! log written alongside, the products handed back.
+
+use polhode::log::{McapLogger, samples, telemetry};
+use polhode::model::{HubState, Observation, Spacecraft};
+use polhode::scenario::{self, Overrides};
+use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Warning};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// Output samples stored column-major in one buffer: column k holds `cap` slots starting at
+/// `k * cap`, of which the first `len` are filled. Handed to numpy as one `(width, n)` array
+/// whose rows are the columns, so the telemetry, `t`, `omega` and `q` are views of a single
+/// allocation, made by Rust and owned by numpy without a copy.
+pub(crate) struct ColumnStore {
+    pub(crate) width: usize,
+    pub(crate) cap: usize,
+    pub(crate) len: usize,
+    pub(crate) data: Vec<f64>,
+}
+
+/// Samples reserved up front at most; a longer run grows the buffer by doubling.
+pub(crate) const MAX_RESERVED_SAMPLES: usize = 1 << 21;
+
+impl ColumnStore {
+    /// Room for `samples` samples (at most [`MAX_RESERVED_SAMPLES`]); the zeroed buffer is
+    /// committed by the OS page by page as samples arrive.
+    fn new(width: usize, samples: usize) -> Self {
+        let cap = samples.clamp(1, MAX_RESERVED_SAMPLES);
+        ColumnStore {
+            width,
+            cap,
+            len: 0,
+            data: vec![0.0; width * cap],
+        }
+    }
+
+    fn push(&mut self, row: &[f64]) {
+        if self.len == self.cap {
+            let cap = self.cap * 2;
+            let mut data = vec![0.0; self.width * cap];
+            for k in 0..self.width {
+                data[k * cap..k * cap + self.len]
+                    .copy_from_slice(&self.data[k * self.cap..k * self.cap + self.len]);
+            }
+            self.data = data;
+            self.cap = cap;
+        }
+        for (k, v) in row.iter().take(self.width).enumerate() {
+            self.data[k * self.cap + self.len] = *v;
+        }
+        self.len += 1;
+    }
+
+    /// The filled columns back to back (`width * len` values), the buffer shrunk to fit.
+    fn into_columns(mut self) -> Vec<f64> {
+        if self.len < self.cap {
+            for k in 1..self.width {
+                let from = k * self.cap;
+                self.data.copy_within(from..from + self.len, k * self.len);
+            }
+            self.data.truncate(self.width * self.len);
+            self.data.shrink_to_fit();
+        }
+        self.data
+    }
+}
+
+/// Keeps every output sample's telemetry and effector fields (the columns of
+/// `polhode run --csv`) and forwards everything to the MCAP log when there is one.
+pub(crate) struct Collector<'a> {
+    pub(crate) spacecraft: &'a Spacecraft,
+    pub(crate) store: ColumnStore,
+    /// The current sample's values (scratch).
+    pub(crate) row: Vec<f64>,
+    /// The log, when `log=` names one.
+    pub(crate) log: Option<McapLogger<'a>>,
+}
+
+impl Sink for Collector<'_> {
+    fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()> {
+        // The same values, in the same order, as the sample tables (polhode::log::samples).
+        self.row.clear();
+        self.row.extend_from_slice(&telemetry::values(o, inv));
+        let hub = HubState {
+            t: o.t,
+            omega: o.omega,
+            attitude: &y[3..7],
+        };
+        for (k, e) in self.spacecraft.effectors().iter().enumerate() {
+            self.row
+                .extend(e.telemetry(&hub, self.spacecraft.effector_states(k, y)));
+        }
+        self.store.push(&self.row);
+        match self.log.as_mut() {
+            Some(log) => log.sample(o, y, inv),
+            None => Ok(()),
+        }
+    }
+
+    fn event(&mut self, e: &EventRecord, o: &Observation) -> std::io::Result<()> {
+        match self.log.as_mut() {
+            Some(log) => log.event(e, o),
+            None => Ok(()),
+        }
+    }
+
+    fn warning(&mut self, w: &Warning) -> std::io::Result<()> {
+        match self.log.as_mut() {
+            Some(log) => log.warning(w),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What a finished run hands back to the calling thread.
+pub(crate) struct Products {
+    /// Column names: the `/telemetry` fields, then `<effector>.<field>`.
+    pub(crate) names: Vec<String>,
+    /// The columns back to back, `n` values each.
+    pub(crate) columns: Vec<f64>,
+    /// Output samples.
+    pub(crate) n: usize,
+    pub(crate) outcome: Outcome,
+    pub(crate) summary_json: String,
+}
+
+/// Why a run produced nothing.
+pub(crate) enum RunError {
+    /// The scenario with the overrides does not validate.
+    Scenario(scenario::ScenarioError),
+    /// The log would be too large (the CLI's message).
+    LogTooLarge(String),
+    /// The log could not be created, written or finished.
+    Io(String),
+}
+
+/// Validates with `overrides` and runs, on the worker thread (no Python here).
+pub(crate) fn execute(
+    path: &Path,
+    source: String,
+    overrides: &Overrides,
+    log: bool,
+    interrupt: &AtomicBool,
+) -> Result<Products, RunError> {
+    let s = scenario::parse(path, source, overrides).map_err(RunError::Scenario)?;
+    let logger = if log {
+        let mut logger = McapLogger::create(&s.mcap_path, &s, s.omega0.norm()).map_err(|e| {
+            RunError::Io(format!(
+                "cannot write the log to {}: {e}",
+                s.mcap_path.display()
+            ))
+        })?;
+        let estimate_mb = logger.estimate_bytes(&s) / 1e6;
+        if estimate_mb > s.max_log_mb {
+            logger.abandon();
+            return Err(RunError::LogTooLarge(format!(
+                "{}: the log would be about {estimate_mb:.3e} MB before compression, above \
+                 the limit of {} MB; lower `output.rate`, shorten the run, or raise \
+                 `output.max_log_mb`",
+                s.path.display(),
+                s.max_log_mb
+            )));
+        }
+        Some(logger)
+    } else {
+        None
+    };
+    let names: Vec<String> = samples::columns(&s.spacecraft)
+        .into_iter()
+        .map(|c| c.name)
+        .collect();
+    // Samples at k / rate up to the end, and the last instant.
+    let expected = (s.duration * s.output_rate).floor().max(0.0) as usize + 2;
+    let mut collector = Collector {
+        spacecraft: &s.spacecraft,
+        store: ColumnStore::new(names.len(), expected),
+        row: Vec::with_capacity(names.len()),
+        log: logger,
+    };
+    let control = Control {
+        interrupt,
+        progress: None,
+    };
+    let outcome = match sim::run(&s, &mut collector, control) {
+        Ok(outcome) => outcome,
+        Err(e) => {
+            if let Some(l) = collector.log.take() {
+                l.abandon();
+            }
+            return Err(RunError::Io(format!(
+                "writing the log failed: {e}; no log was kept"
+            )));
+        }
+    };
+    let written = match collector.log.take() {
+        Some(l) => Some(
+            l.finish(&s, &s.method.describe(), &outcome)
+                .map_err(|e| RunError::Io(format!("finishing the log failed: {e}")))?,
+        ),
+        None => None,
+    };
+    let summary_json = polhode::cli::summary_json(&s, &outcome, written.as_deref());
+    let n = collector.store.len;
+    Ok(Products {
+        names,
+        columns: collector.store.into_columns(),
+        n,
+        outcome,
+        summary_json,
+    })
+}
