@@ -1,8 +1,8 @@
 //! One run on a worker thread: the samples collected column by column into one buffer, the
 //! log written alongside, the products handed back.
 
-use polhode::log::{McapLogger, samples, telemetry};
-use polhode::model::{HubState, Observation, Spacecraft};
+use polhode::log::{McapLogger, samples};
+use polhode::model::{Observation, Spacecraft};
 use polhode::scenario::{self, Overrides};
 use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Warning};
 use std::path::Path;
@@ -79,18 +79,7 @@ pub(crate) struct Collector<'a> {
 
 impl Sink for Collector<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()> {
-        // The same values, in the same order, as the sample tables (polhode::log::samples).
-        self.row.clear();
-        self.row.extend_from_slice(&telemetry::values(o, inv));
-        let hub = HubState {
-            t: o.t,
-            omega: o.omega,
-            attitude: &y[3..7],
-        };
-        for (k, e) in self.spacecraft.effectors().iter().enumerate() {
-            self.row
-                .extend(e.telemetry(&hub, self.spacecraft.effector_states(k, y)));
-        }
+        samples::fill_row(&mut self.row, self.spacecraft, o, y, inv);
         self.store.push(&self.row);
         match self.log.as_mut() {
             Some(log) => log.sample(o, y, inv),

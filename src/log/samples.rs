@@ -235,19 +235,24 @@ impl<'a> SampleTable<'a> {
     }
 }
 
+/// Fills `row` with one sample's values in [`columns`] order: the `/telemetry` fields, then
+/// each effector's fields (shared by the tables and the Python package).
+pub fn fill_row(row: &mut Vec<f64>, sc: &Spacecraft, o: &Observation, y: &[f64], inv: &Reference) {
+    row.clear();
+    row.extend_from_slice(&telemetry::values(o, inv));
+    let hub = HubState {
+        t: o.t,
+        omega: o.omega,
+        attitude: &y[3..7],
+    };
+    for (k, e) in sc.effectors().iter().enumerate() {
+        row.extend(e.telemetry(&hub, sc.effector_states(k, y)));
+    }
+}
+
 impl Sink for SampleTable<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> io::Result<()> {
-        self.row.clear();
-        self.row.extend_from_slice(&telemetry::values(o, inv));
-        let hub = HubState {
-            t: o.t,
-            omega: o.omega,
-            attitude: &y[3..7],
-        };
-        for (k, e) in self.spacecraft.effectors().iter().enumerate() {
-            self.row
-                .extend(e.telemetry(&hub, self.spacecraft.effector_states(k, y)));
-        }
+        fill_row(&mut self.row, self.spacecraft, o, y, inv);
         if let Some((_, w)) = self.csv.as_mut() {
             use std::fmt::Write as _;
             self.text.clear();
