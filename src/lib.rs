@@ -54,6 +54,39 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
+//! ## The same run logged to MCAP
+//!
+//! [`scenario::Scenario::from_simulation`] gives a code-built run the log settings a file
+//! would have had (default epoch, no orbit, a box for the viewers); the log opens in Foxglove
+//! and Rerun like the command line's.
+//!
+//! ```
+//! use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+//! use polhode::log::McapLogger;
+//! use polhode::model::{RigidBody, Spacecraft};
+//! use polhode::scenario::Scenario;
+//! use polhode::sim::{self, Adaptive, Control, Method, Simulation};
+//!
+//! let inertia = Matrix3::from_diagonal(&Vector3::new(10.0, 12.0, 14.0)); // kg m²
+//! let spacecraft = Spacecraft::new(RigidBody::new(inertia)?, Vector3::x());
+//! let tolerances = Adaptive { rtol: 1e-9, atol: 1e-12, max_step: f64::INFINITY };
+//! let run = Simulation::new(
+//!     spacecraft,
+//!     Vector3::new(0.02, 1.0, 0.02), // rad/s: near the intermediate axis, so it tumbles
+//!     UnitQuaternion::identity(),
+//!     60.0, // s
+//!     Method::Dop853(tolerances),
+//! );
+//! let scene = Scenario::from_simulation("intermediate axis", run);
+//! let path = std::env::temp_dir().join("polhode-doc-intermediate-axis.mcap");
+//! let mut logger = McapLogger::create(&path, &scene, scene.omega0.norm())?;
+//! let outcome = sim::run(&scene, &mut logger, Control::uninterrupted())?;
+//! let written = logger.finish(&scene, &scene.method.describe(), &outcome)?;
+//! assert!(std::fs::metadata(&written)?.len() > 0);
+//! # std::fs::remove_file(&written)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! ## A scenario file
 //!
 //! ```

@@ -165,7 +165,7 @@ def test_the_interpreter_exits_cleanly_after_reading_the_table():
 
 
 def test_the_gil_is_released_during_a_campaign():
-    """Another Python thread keeps running (no gap over 0.25 s) while a campaign goes."""
+    """Another Python thread keeps running while a campaign goes (stalled under half of it)."""
     import threading
 
     import numpy as np
@@ -190,5 +190,11 @@ def test_the_gil_is_released_during_a_campaign():
     assert outcome["seconds"] > 0.5, "the campaign must last long enough to tell"
     assert len(ticks) > 10
     gaps = np.diff(ticks)
-    assert gaps.max() < 0.25, f"this thread stalled {gaps.max():.3f} s during the campaign"
+    # Held through the campaign, the GIL would stall this thread for all of it. A busy machine
+    # may deschedule it now and then, so the test bounds the total of the long gaps rather than
+    # the longest one.
+    stalled = gaps[gaps > 0.1].sum()
+    assert stalled < 0.5 * outcome["seconds"], (
+        f"this thread stalled {stalled:.3f} s of the campaign's {outcome['seconds']:.3f} s"
+    )
     assert outcome["campaign"].runs == 300

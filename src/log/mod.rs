@@ -522,7 +522,9 @@ impl<'a> McapLogger<'a> {
         let mut meta = BTreeMap::new();
         meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
         meta.insert("scenario".into(), scenario.name.clone());
-        meta.insert("scenario_file".into(), scenario.path.display().to_string());
+        if !scenario.path.as_os_str().is_empty() {
+            meta.insert("scenario_file".into(), scenario.path.display().to_string());
+        }
         meta.insert("integrator".into(), method.into());
         meta.insert("epoch".into(), format_epoch(scenario.epoch_unix_ns));
         if scenario.epoch_unix_ns < 0 {
@@ -543,12 +545,17 @@ impl<'a> McapLogger<'a> {
             "rhs_evaluations".into(),
             outcome.stats.rhs_evaluations.to_string(),
         );
-        let attachment = Attachment {
-            name: "scenario.yaml".into(),
-            media_type: "application/yaml".into(),
-            data: scenario.source.as_bytes().to_vec(),
+        // A scenario built in code ([`Scenario::from_simulation`]) has no text to attach.
+        let attachments = if scenario.source.is_empty() {
+            Vec::new()
+        } else {
+            vec![Attachment {
+                name: "scenario.yaml".into(),
+                media_type: "application/yaml".into(),
+                data: scenario.source.as_bytes().to_vec(),
+            }]
         };
-        self.finish_with("polhode", meta, vec![attachment])
+        self.finish_with("polhode", meta, attachments)
     }
 
     /// Writes how the current run ended to its `/log` topic.

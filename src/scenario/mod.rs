@@ -9,6 +9,7 @@ mod body;
 pub mod campaign;
 mod effectors;
 mod error;
+mod initial;
 mod integrator;
 mod orbit;
 mod output;
@@ -17,6 +18,8 @@ mod time;
 pub use body::BodySpec;
 use body::ValidHub;
 pub use effectors::{EffectorSpec, HubMotionSpec};
+use initial::check_rate;
+pub use initial::{InitialSpec, QuaternionSpec};
 pub use integrator::IntegratorSpec;
 use integrator::{MethodChoice, from};
 pub use output::{Compression, OutputSpec};
@@ -29,7 +32,7 @@ pub use crate::sim::{Adaptive, Condition, DriftLimits, Method, OnBreach, Quantit
 
 use crate::model::{RigidBody, Spacecraft};
 use crate::sim::Simulation;
-use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::{Path, PathBuf};
@@ -162,38 +165,6 @@ pub enum ShapeSpec {
     },
 }
 
-/// `initial:` state at sim time 0.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct InitialSpec {
-    /// Body rates (rad/s).
-    #[serde(default)]
-    pub omega: Option<Spanned<[f64; 3]>>,
-    /// Body rates (rev/min), instead of `omega`.
-    #[serde(default)]
-    pub omega_rpm: Option<Spanned<[f64; 3]>>,
-    /// Attitude, body → inertial (default identity); body → LVLH with `frame: lvlh`.
-    #[serde(default)]
-    pub attitude: Option<Spanned<QuaternionSpec>>,
-    /// `inertial` (default) or `lvlh`: the frame `attitude` and the rates are relative to.
-    #[serde(default)]
-    pub frame: Option<Spanned<String>>,
-}
-
-/// A quaternion by named components (scalar `w`).
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct QuaternionSpec {
-    /// Scalar part.
-    pub w: f64,
-    /// Vector part, x.
-    pub x: f64,
-    /// Vector part, y.
-    pub y: f64,
-    /// Vector part, z.
-    pub z: f64,
-}
-
 /// A condition on a logged quantity, e.g. `{nutation_angle_deg: {above: 89.0}}`.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
@@ -316,6 +287,38 @@ pub struct Scenario {
     pub max_log_mb: f64,
     /// The orbit (`orbit:`), when the scenario has one.
     pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
+}
+
+impl Scenario {
+    /// A scenario around a [`Simulation`] built in code, so that it can be logged to MCAP
+    /// like a file's: the default epoch ([`DEFAULT_EPOCH`]), no orbit, 10 scene updates per
+    /// second, LZ4 chunks, a box with the hub's inertia proportions for the viewers, the log
+    /// at `logs/<name>.mcap`, and no scenario attachment (there is no source text).
+    pub fn from_simulation(name: &str, simulation: Simulation) -> Scenario {
+        let hub = &simulation.spacecraft.hub;
+        let shape = Shape::Box {
+            size: hub.equivalent_box(1.0),
+            orientation: UnitQuaternion::from_matrix(&hub.principal_axes),
+        };
+        Scenario {
+            path: PathBuf::new(),
+            source: String::new(),
+            name: name.to_string(),
+            description: String::new(),
+            epoch_unix_ns: parse_epoch(DEFAULT_EPOCH).expect("the default epoch parses"),
+            method_choice: None,
+            mcap_path: output::default_log_path(name),
+            scene_rate: 10.0,
+            compression: Compression::default(),
+            shape,
+            composite: None,
+            warnings: Vec::new(),
+            montecarlo: None,
+            max_log_mb: DEFAULT_MAX_LOG_MB,
+            orbit: None,
+            simulation,
+        }
+    }
 }
 
 /// A scenario is a [`Simulation`] with the provenance and output settings the YAML front end
@@ -692,21 +695,6 @@ pub fn number(v: f64) -> String {
     }
 }
 
-/// Refuses initial body rates beyond [`MAX_RATE`].
-fn check_rate(w: &Vector3<f64>) -> Result<(), String> {
-    // Scaled, so that huge components do not overflow the norm.
-    let m = w.amax();
-    let n = if m > 0.0 { m * (w / m).norm() } else { 0.0 };
-    if n > MAX_RATE {
-        Err(format!(
-            "|ω| = {n:e} rad/s is beyond the {MAX_RATE:e} rad/s polhode supports (is it in \
-             deg/s or rev/min? `omega` is rad/s, `omega_rpm` rev/min)"
-        ))
-    } else {
-        Ok(())
-    }
-}
-
 /// Checks the `checks:` block against what the spacecraft conserves.
 fn drift_limits(
     path: &Path,
@@ -822,68 +810,7 @@ impl ScenarioFile {
             field: inertia_field,
         } = self.body.hub(path, &source)?;
 
-        // Initial state.
-        let omega0 = match (&self.initial.omega, &self.initial.omega_rpm) {
-            (Some(_), Some(r)) => {
-                return Err(err(
-                    loc(r),
-                    "initial.omega_rpm",
-                    "give either `omega` (rad/s) or `omega_rpm`, not both".into(),
-                ));
-            }
-            (Some(w), None) => {
-                if !finite3(&w.value) {
-                    return Err(err(
-                        loc(w),
-                        "initial.omega",
-                        "expected three finite numbers (rad/s)".into(),
-                    ));
-                }
-                let w = Vector3::from(w.value);
-                check_rate(&w).map_err(|m| err(loc_of(&self.initial.omega), "initial.omega", m))?;
-                w
-            }
-            (None, Some(r)) => {
-                if !finite3(&r.value) {
-                    return Err(err(
-                        loc(r),
-                        "initial.omega_rpm",
-                        "expected three finite numbers (rev/min)".into(),
-                    ));
-                }
-                let w = Vector3::from(r.value) * (2.0 * std::f64::consts::PI / 60.0);
-                check_rate(&w)
-                    .map_err(|m| err(loc_of(&self.initial.omega_rpm), "initial.omega_rpm", m))?;
-                w
-            }
-            (None, None) => {
-                return Err(err(
-                    key_location(&source, "initial"),
-                    "initial",
-                    "missing the body rates: expected `omega: [wx, wy, wz]` (rad/s) or \
-                     `omega_rpm: [..]`"
-                        .into(),
-                ));
-            }
-        };
-        let attitude0 = match &self.initial.attitude {
-            None => UnitQuaternion::identity(),
-            Some(a) => {
-                let q = Quaternion::new(a.value.w, a.value.x, a.value.y, a.value.z);
-                let n = q.norm();
-                if !q.coords.iter().all(|c| c.is_finite()) || (n - 1.0).abs() > 1e-6 {
-                    return Err(err(
-                        loc(a),
-                        "initial.attitude",
-                        format!(
-                            "expected a unit quaternion {{w, x, y, z}} (norm within 1e-6 of 1), \
-                             got norm {n}"
-                        ),
-                    ));
-                }
-                UnitQuaternion::from_quaternion(q)
-            }
-        };
+        let (omega0, attitude0) = self.initial.state(path, &source)?;
 
         // The orbit, and the initial state given relative to its LVLH frame.
         let orbit = match &self.orbit {

@@ -120,7 +120,7 @@ impl OutputSpec {
             (None, Some(p)) => {
                 return Err(err(loc(p), "output.mcap", "expected a file path".into()));
             }
-            (None, None) => PathBuf::from(format!("logs/{}.mcap", sanitize(name))),
+            (None, None) => default_log_path(name),
         };
         let max_log_mb = match (ov.max_log_mb, &self.max_log_mb) {
             (Some(v), _) if v.is_finite() && v > 0.0 => v,
@@ -157,6 +157,12 @@ pub(super) fn output_rate_hint(out: &Option<OutputSpec>) -> f64 {
         .map(|r| r.value)
         .filter(|r| r.is_finite() && *r > 0.0)
         .unwrap_or(100.0)
+}
+
+/// Where a scenario's log goes unless `output.mcap` or `--mcap` says otherwise:
+/// `logs/<name>.mcap`, the name [`sanitize`]d.
+pub(super) fn default_log_path(name: &str) -> PathBuf {
+    PathBuf::from(format!("logs/{}.mcap", sanitize(name)))
 }
 
 /// The log file's default name: the scenario's name with anything but letters, digits, `-`
