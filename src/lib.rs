@@ -114,6 +114,7 @@
 
 #![deny(missing_docs)]
 
+pub mod averaging;
 pub mod bench;
 pub mod cli;
 pub mod compare;

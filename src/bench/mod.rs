@@ -7,6 +7,7 @@
 //! minimum is the least disturbed estimate of the method's cost.
 
 pub mod failure;
+pub mod secular;
 pub mod work_precision;
 
 use crate::integrate::Stats;

@@ -184,6 +184,22 @@ pub(super) enum BenchCommand {
         #[command(flatten)]
         out: OutArgs,
     },
+    /// The averaged method against dop853 (rtol 1e-10) on the same scene: speed-up, event
+    /// times and energies, as JSON (one line per scene).
+    Averaged {
+        /// Scenario YAML files.
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        /// rtol of the averaged method (default: the scene's).
+        #[arg(long)]
+        rtol: Option<f64>,
+        /// Times (s, on the scene's output grid) at which to compare T and |H|.
+        #[arg(long, value_delimiter = ',')]
+        times: Vec<f64>,
+        /// Timed runs of each method; the fastest counts.
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+    },
     /// Error growth of every method near the separatrix, with the problem's conditioning.
     Separatrix {
         /// Simulated time (s).
@@ -228,7 +244,7 @@ pub(super) struct SweepArgs {
 /// Method options shared by `run` and `bench point`.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct MethodArgs {
-    /// Integration method: rk4, dopri5, dop853, radau5, gauss, lie, splitting, exact or auto.
+    /// Integration method: rk4, dopri5, dop853, radau5, gauss, lie, splitting, exact, averaged or auto.
     #[arg(long)]
     pub method: Option<String>,
     /// Fixed step for rk4, gauss, lie and splitting (s).

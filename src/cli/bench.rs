@@ -28,6 +28,33 @@ pub(super) fn bench_cmd(what: BenchCommand) -> i32 {
                 }
             }
         }
+        BenchCommand::Averaged {
+            scenarios,
+            rtol,
+            times,
+            repeats,
+        } => {
+            if let Some(r) = rtol
+                && !(r.is_finite() && (1e-15..1.0).contains(&r))
+            {
+                eprintln!("error: --rtol: expected a tolerance from 1e-15 to 1, got {r}");
+                return EXIT_BAD_INPUT;
+            }
+            if times.iter().any(|t| !(t.is_finite() && *t >= 0.0)) {
+                eprintln!("error: --times: expected non-negative times in seconds");
+                return EXIT_BAD_INPUT;
+            }
+            for path in &scenarios {
+                match crate::bench::secular::compare(path, rtol, &times, repeats) {
+                    Ok(c) => println!("{}", serde_json::to_string(&c).expect("serialisable")),
+                    Err(e) => {
+                        eprintln!("error: {}: {e}", path.display());
+                        return EXIT_FAILED;
+                    }
+                }
+            }
+            0
+        }
         BenchCommand::Drift { duration, out } => {
             if !(duration.is_finite() && duration > 0.0) {
                 eprintln!("error: --duration: expected a positive number of seconds");

@@ -7,7 +7,10 @@
 //! maximum-inertia axis with T = |H|²/(2 I_max). One bookkeeping state, the dissipated energy.
 //! The coefficient can be given directly or solved from a target nutation time constant.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{
+    Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Secular, SecularMotion,
+    SecularRates,
+};
 use nalgebra::{Matrix3, Vector3};
 
 /// Energy-sink torque.
@@ -76,6 +79,9 @@ impl Effector for EnergySink {
         // ω·τ = −c ω·ω⊥ = −c |ω⊥|² (ω⊥ ⊥ Ĥ, so ω·ω⊥ = ω⊥·ω⊥).
         dx[0] = self.coefficient * self.transverse_rate(&hub.omega).norm_squared();
     }
+    fn secular(&self) -> Option<Box<dyn Secular>> {
+        Some(Box::new(self.clone()))
+    }
     fn energy(&self, hub: &HubState, x: &[f64]) -> EnergyAccount {
         EnergyAccount {
             elastic: 0.0,
@@ -92,5 +98,22 @@ impl Effector for EnergySink {
             x[0],
             self.coefficient * self.transverse_rate(&hub.omega).norm_squared(),
         ]
+    }
+}
+
+impl Secular for EnergySink {
+    fn rates(&self, motion: &SecularMotion) -> SecularRates {
+        // ω·Ĥ = 2T/|H| is constant along the motion, so ⟨|ω⊥|²⟩ = ⟨|ω|²⟩ − (2T/|H|)².
+        if motion.h == 0.0 {
+            return SecularRates::default();
+        }
+        let along = 2.0 * motion.energy / motion.h;
+        let transverse = (motion.omega_omega.trace() - along * along).max(0.0);
+        let power = self.coefficient * transverse;
+        SecularRates {
+            energy_rate: -power,
+            h_rate: 0.0,
+            dissipation_rate: power,
+        }
     }
 }

@@ -5,7 +5,10 @@
 //! as energy (Rayleigh's dissipation function: Goldstein, *Classical Mechanics*, §1.5). One
 //! bookkeeping state, the dissipated energy (Ẇ = 2R), closes the energy balance T + W = T₀.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{
+    Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Secular, SecularMotion,
+    SecularRates,
+};
 use nalgebra::{Matrix3, Vector3};
 
 /// Rayleigh dissipation torque.
@@ -65,6 +68,9 @@ impl Effector for Rayleigh {
     ) {
         dx[0] = 2.0 * self.dissipation_function(&hub.omega);
     }
+    fn secular(&self) -> Option<Box<dyn Secular>> {
+        Some(Box::new(self.clone()))
+    }
     fn energy(&self, hub: &HubState, x: &[f64]) -> EnergyAccount {
         EnergyAccount {
             elastic: 0.0,
@@ -78,5 +84,22 @@ impl Effector for Rayleigh {
     }
     fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
         vec![x[0], 2.0 * self.dissipation_function(&hub.omega)]
+    }
+}
+
+impl Secular for Rayleigh {
+    fn rates(&self, motion: &SecularMotion) -> SecularRates {
+        // ⟨ωᵀ A ω⟩ = tr(A ⟨ω ωᵀ⟩): dT/dt = −ωᵀΓω and d|H|/dt = Ĥ·τ = −(Jω)ᵀΓω / |H|.
+        let power = (self.gamma * motion.omega_omega).trace();
+        let h_rate = if motion.h > 0.0 {
+            -(motion.inertia * self.gamma * motion.omega_omega).trace() / motion.h
+        } else {
+            0.0
+        };
+        SecularRates {
+            energy_rate: -power,
+            h_rate,
+            dissipation_rate: power,
+        }
     }
 }

@@ -124,6 +124,8 @@ pub struct TorqueFreeSolution {
     lambda: f64,
     period: f64,
     delta: f64,
+    /// `delta` before reduction to [0, 2π) (rad).
+    delta_total: f64,
     moments: Vector3<f64>,
     axes: Matrix3<f64>,
     h_inertial: Vector3<f64>,
@@ -425,6 +427,7 @@ impl TorqueFreeSolution {
             lambda: 0.0,
             period: f64::INFINITY,
             delta: f64::NAN,
+            delta_total: f64::NAN,
             moments: Vector3::new(i1, i2, i3),
             axes: p,
             h_inertial,
@@ -554,7 +557,8 @@ impl TorqueFreeSolution {
         self.lambda = lambda;
         if axis != 2 {
             self.period = TAU / lambda;
-            self.delta = (omega0.norm() * self.period).rem_euclid(TAU);
+            self.delta_total = omega0.norm() * self.period;
+            self.delta = self.delta_total.rem_euclid(TAU);
         }
     }
 
@@ -577,7 +581,8 @@ impl TorqueFreeSolution {
         self.lambda = rate_k.abs();
         if rate_k != 0.0 {
             self.period = TAU / rate_k.abs();
-            self.delta = (h / i_t * self.period).rem_euclid(TAU);
+            self.delta_total = h / i_t * self.period;
+            self.delta = self.delta_total.rem_euclid(TAU);
         }
         self.motion = Motion::Symmetric(SymmetricMotion {
             axis: a,
@@ -676,6 +681,7 @@ impl TorqueFreeSolution {
             };
             self.period = 4.0 * k / lambda;
             let phi_t = em.spin_rate.mul_add(self.period, 4.0 * em.kappa * em.pi_k);
+            self.delta_total = phi_t;
             self.delta = phi_t.rem_euclid(TAU);
         }
         self.motion = Motion::Elliptic(Box::new(em));
@@ -748,6 +754,14 @@ impl TorqueFreeSolution {
     /// the period is infinite.
     pub fn precession_per_period(&self) -> f64 {
         self.delta
+    }
+
+    /// The precession angle (rad) of one polhode period before its reduction to [0, 2π): the
+    /// Euler angle φ about Ĥ_N gained over the period (3-1-3 about the circulation axis;
+    /// the symmetry axis for a symmetric body). Over the period it is the mean precession rate
+    /// times the period. NaN when the period is infinite.
+    pub fn precession_angle_per_period(&self) -> f64 {
+        self.delta_total
     }
 
     /// Motion regime (see [`Regime`]).

@@ -19,9 +19,11 @@
 
 mod body;
 mod observe;
+mod secular;
 
 pub use body::{InertiaError, RigidBody};
 pub use observe::{Invariants, Observation};
+pub use secular::{Secular, SecularMotion, SecularRates};
 
 use crate::integrate::OdeSystem;
 use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
@@ -283,6 +285,12 @@ pub trait Effector: Debug + Send + Sync {
     /// The gradient G of its field (1/s², body axes) at the hub state, for the tidal force
     /// `m G r` on a moving particle at r ([`TidalCoupling`]).
     fn tidal_gradient(&self, _hub: &HubState) -> Option<Matrix3<f64>> {
+        None
+    }
+    /// Its effect averaged over one period of the torque-free motion, for `method: averaged`:
+    /// `None` (the default) when it cannot be averaged that way. Only effectors without
+    /// dynamic states whose one state is the energy they dissipated answer.
+    fn secular(&self) -> Option<Box<dyn Secular>> {
         None
     }
     /// Whether its [`Effector::couple`] only adds a torque: nothing in the mass matrix, no

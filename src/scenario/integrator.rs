@@ -237,6 +237,7 @@ impl IntegratorSpec {
                 order,
             },
             "exact" => Method::Exact,
+            "averaged" => Method::Averaged(adaptive),
             "auto" => {
                 // Resolved once the spacecraft is built; dop853 stands in for the checks.
                 auto = true;

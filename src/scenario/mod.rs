@@ -1046,6 +1046,11 @@ impl ScenarioFile {
                     .into(),
             ));
         }
+        if matches!(method, Method::Averaged(_))
+            && let Some(why) = crate::averaging::refusal(&spacecraft)
+        {
+            return Err(err(method_l, method_field, why));
+        }
         if matches!(method, Method::Splitting { .. }) && spacecraft.motion().is_some() {
             return Err(err(
                 method_l,

@@ -60,11 +60,15 @@ pub enum Method {
     },
     /// Closed-form torque-free solution.
     Exact,
+    /// Averaged (secular) propagation of a slowly dissipating spinner: the slow variables
+    /// (|H|, T, each effector's dissipated energy) stepped by DOP853 with these tolerances
+    /// on their period-averaged rates, the fast motion rebuilt from the exact solution.
+    Averaged(Adaptive),
 }
 
 impl Method {
     /// Names accepted in YAML and on the command line (`auto` picks one of the others).
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 10] = [
         "rk4",
         "dopri5",
         "dop853",
@@ -73,6 +77,7 @@ impl Method {
         "lie",
         "splitting",
         "exact",
+        "averaged",
         "auto",
     ];
 
@@ -87,6 +92,7 @@ impl Method {
             Method::Lie { .. } => "lie",
             Method::Splitting { .. } => "splitting",
             Method::Exact => "exact",
+            Method::Averaged(_) => "averaged",
         }
     }
 
@@ -106,6 +112,15 @@ impl Method {
             Method::Lie { dt } => format!("lie (RKMK4, dt {dt:e} s)"),
             Method::Splitting { dt, order } => format!("splitting (order {order}, dt {dt:e} s)"),
             Method::Exact => "exact (closed-form torque-free solution)".into(),
+            Method::Averaged(a) => {
+                // The slow variables are scaled by their initial values: no atol applies.
+                let cap = if a.max_step.is_finite() {
+                    format!(", max_step {:e} s", a.max_step)
+                } else {
+                    String::new()
+                };
+                format!("averaged (secular, rtol {:e}{cap})", a.rtol)
+            }
         }
     }
 
@@ -123,7 +138,9 @@ impl Method {
     /// The settings of an adaptive method.
     pub fn adaptive(&self) -> Option<Adaptive> {
         match *self {
-            Method::Dopri5(a) | Method::Dop853(a) | Method::Radau5(a) => Some(a),
+            Method::Dopri5(a) | Method::Dop853(a) | Method::Radau5(a) | Method::Averaged(a) => {
+                Some(a)
+            }
             _ => None,
         }
     }

@@ -834,6 +834,11 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
                 "the closed-form solution failed".into(),
                 "report this as a bug with the scenario attached".into(),
             ),
+            (None, _) if matches!(m, Method::Averaged(_)) => (
+                "the averaged method's assumptions failed here (the message above says which)"
+                    .into(),
+                "run this scene, or its remaining part, with dop853".into(),
+            ),
             (None, _) if !m.is_implicit() && stiffness.is_some_and(|s| s.ratio() > 1e3) => (
                 format!(
                     "stiffness: the fastest eigenvalue |λ| = {rho:.4e} 1/s is {:.1e} times the \

@@ -10,6 +10,7 @@
 //!   everything else (torques, effectors), of order 2 (Strang) and 4 (triple jump).
 
 use super::{Adaptive, Method, Simulation};
+use crate::averaging::AveragedStepper;
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{
     Dop853, Dopri5, FixedGrid, Gauss, GaussStages, OdeSystem, Radau5, Rk4, Stats, StepError,
@@ -37,6 +38,8 @@ pub enum AnyStepper {
     Splitting(SplittingStepper),
     /// The closed-form torque-free solution.
     Exact(ExactStepper),
+    /// Averaged (secular) propagation.
+    Averaged(AveragedStepper),
 }
 
 impl AnyStepper {
@@ -86,6 +89,7 @@ impl AnyStepper {
                 AnyStepper::Splitting(SplittingStepper::new(sc, 0.0, y0, dt, order)?)
             }
             Method::Exact => AnyStepper::Exact(ExactStepper::new(sc, y0, sim.output_rate)?),
+            Method::Averaged(a) => AnyStepper::Averaged(AveragedStepper::new(sc, y0, a)?),
         })
     }
 }
@@ -101,6 +105,7 @@ macro_rules! each {
             AnyStepper::Lie($s) => $e,
             AnyStepper::Splitting($s) => $e,
             AnyStepper::Exact($s) => $e,
+            AnyStepper::Averaged($s) => $e,
         }
     };
 }

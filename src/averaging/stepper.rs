@@ -1,0 +1,421 @@
+//! `method: averaged` as a [`Stepper`]: steps the slow system with DOP853 and rebuilds the
+//! full state (ω, q and each effector's dissipated energy) from the exact torque-free
+//! solution at the slow state, so that sampling, events and logs work as for other methods.
+
+use super::motion::{Moments, PeriodAverages};
+use super::{MAX_EPSILON, SEPARATRIX_LAYER};
+use crate::exact::TorqueFreeSolution;
+use crate::integrate::{Dop853, OdeSystem, Stats, StepError, Stepper, Tolerances};
+use crate::model::{Secular, SecularMotion, Spacecraft};
+use crate::sim::Adaptive;
+use nalgebra::{Matrix3, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
+use std::f64::consts::TAU;
+
+/// Slow state layout: z = [|H|/H₀, T/T₀, polhode phase (periods), precession angle (rad),
+/// W₁/T₀, …].
+const H: usize = 0;
+const T: usize = 1;
+const PHASE: usize = 2;
+const PRECESSION: usize = 3;
+const EFFECTORS: usize = 4;
+
+/// The slow system: the period-averaged rates of |H|, T, the fast phases and each effector's
+/// dissipated energy, functions of (|H|, T) only.
+struct SlowSystem {
+    moments: Moments,
+    axes: Matrix3<f64>,
+    inertia: Matrix3<f64>,
+    effects: Vec<Box<dyn Secular>>,
+    h0: f64,
+    t0: f64,
+}
+
+/// Everything the slow rates give at one slow state.
+struct SlowRates {
+    averages: PeriodAverages,
+    h_rate: f64,
+    energy_rate: f64,
+}
+
+impl SlowSystem {
+    fn rates(&self, z: &[f64], dissipation: Option<&mut [f64]>) -> SlowRates {
+        let h = z[H] * self.h0;
+        let energy = z[T] * self.t0;
+        let averages = self.moments.period_averages(h, energy);
+        let motion = SecularMotion {
+            omega_omega: self.axes * averages.omega_omega * self.axes.transpose(),
+            h,
+            energy,
+            inertia: &self.inertia,
+        };
+        let (mut h_rate, mut energy_rate) = (0.0, 0.0);
+        let mut dissipation = dissipation;
+        for (k, e) in self.effects.iter().enumerate() {
+            let r = e.rates(&motion);
+            h_rate += r.h_rate;
+            energy_rate += r.energy_rate;
+            if let Some(d) = dissipation.as_deref_mut() {
+                d[k] = r.dissipation_rate / self.t0;
+            }
+        }
+        SlowRates {
+            averages,
+            h_rate,
+            energy_rate,
+        }
+    }
+
+    /// ε: the fast period over the dissipation time, and the fast period (s). The fast period
+    /// is the longer of the spin period about H, 2π|H|/(2T), and the polhode period (left out
+    /// within the separatrix layer, where it diverges); the dissipation time is the shorter of
+    /// (T_max − T_min)/|dT/dt| and |H|/|d|H|/dt|.
+    fn epsilon(&self, z: &[f64]) -> (f64, f64) {
+        let r = self.rates(z, None);
+        let h = z[H] * self.h0;
+        let energy = z[T] * self.t0;
+        let [i1, _, i3] = self.moments.i;
+        let mut fast = TAU * h / (2.0 * energy).max(f64::MIN_POSITIVE);
+        if r.averages.m < 1.0 - SEPARATRIX_LAYER && r.averages.period.is_finite() {
+            fast = fast.max(r.averages.period);
+        }
+        let band = h * h * (1.0 / (2.0 * i1) - 1.0 / (2.0 * i3));
+        let tau_t = band / r.energy_rate.abs();
+        let tau_h = h / r.h_rate.abs();
+        (fast / tau_t.min(tau_h), fast)
+    }
+}
+
+impl OdeSystem for SlowSystem {
+    fn dim(&self) -> usize {
+        EFFECTORS + self.effects.len()
+    }
+    fn rhs(&self, _t: f64, z: &[f64], dz: &mut [f64]) {
+        let (head, tail) = dz.split_at_mut(EFFECTORS);
+        let r = self.rates(z, Some(tail));
+        head[H] = r.h_rate / self.h0;
+        head[T] = r.energy_rate / self.t0;
+        head[PHASE] = if r.averages.period.is_finite() {
+            1.0 / r.averages.period
+        } else {
+            0.0
+        };
+        head[PRECESSION] = r.averages.precession_rate;
+    }
+}
+
+/// The averaged method as a stepper over the spacecraft's state vector.
+pub struct AveragedStepper {
+    system: SlowSystem,
+    slow: Dop853,
+    /// Columns X, Y, Ĥ_N: the inertial frame the precession angle is measured in.
+    frame_n: Matrix3<f64>,
+    /// Sign of the rate about the circulation axis after the last step.
+    branch: f64,
+    /// Before the separatrix crossing inside the last step, if there was one.
+    branch_before: f64,
+    /// When the last step crossed the separatrix (s).
+    crossing: Option<f64>,
+    /// Offsets of each effector's dissipated energy in the state vector.
+    offsets: Vec<usize>,
+    y: Vec<f64>,
+    stats: Stats,
+}
+
+/// Why `method: averaged` cannot treat `sc`, naming the effector and the reason.
+pub fn refusal(sc: &Spacecraft) -> Option<String> {
+    if sc.motion().is_some() {
+        return Some(
+            "method `averaged` averages over the torque-free motion, and the hub's rotation \
+             here is prescribed (`hub_motion`); use dop853"
+                .into(),
+        );
+    }
+    for e in sc.effectors() {
+        if e.secular().is_some() {
+            continue;
+        }
+        let why = if e.num_dynamic_states() > 0 {
+            "has internal degrees of freedom; averaging them needs their periodic forced \
+             response along the torque-free motion, which polhode does not compute yet"
+        } else {
+            "applies an environmental or control torque, which does not average over the \
+             torque-free motion (it depends on the orbit, the field or a controller's state)"
+        };
+        return Some(format!(
+            "method `averaged` cannot treat effector `{}` ({}): it {why}; use dop853",
+            e.name(),
+            e.kind()
+        ));
+    }
+    None
+}
+
+impl AveragedStepper {
+    /// Starts at `(0, y0)` with the tolerances `a` on the slow variables; `Err` (a diagnosis)
+    /// when the spacecraft or the initial state cannot be averaged.
+    pub fn new(sc: &Spacecraft, y0: &[f64], a: Adaptive) -> Result<Self, String> {
+        if let Some(why) = refusal(sc) {
+            return Err(why);
+        }
+        let Some(moments) = Moments::new(&sc.hub.principal_moments) else {
+            return Err(
+                "method `averaged`: the body is spherical, so its rates never change and there \
+                 is nothing to average; use exact or dop853"
+                    .into(),
+            );
+        };
+        let inertia = sc.hub.inertia;
+        let axes = sc.hub.principal_axes;
+        let omega0 = Vector3::new(y0[0], y0[1], y0[2]);
+        let q0 = UnitQuaternion::from_quaternion(Quaternion::new(y0[3], y0[4], y0[5], y0[6]));
+        let w_p = axes.transpose() * omega0;
+        let [i1, i2, i3] = moments.i;
+        let h_p = Vector3::new(i1 * w_p.x, i2 * w_p.y, i3 * w_p.z);
+        let h0 = h_p.norm();
+        let t0 = 0.5 * w_p.dot(&h_p);
+        if h0 == 0.0 || t0 <= 0.0 {
+            return Err(
+                "method `averaged`: the body is at rest, so there is nothing to average; use \
+                 dop853"
+                    .into(),
+            );
+        }
+        let h_hat_n = q0 * (axes * h_p) / h0;
+        let frame_n = inertial_frame(&h_hat_n);
+        let effects: Vec<Box<dyn Secular>> =
+            sc.effectors().iter().filter_map(|e| e.secular()).collect();
+        let offsets: Vec<usize> = (0..sc.effectors().len())
+            .map(|k| sc.effector_offset(k))
+            .collect();
+        let system = SlowSystem {
+            moments,
+            axes,
+            inertia,
+            effects,
+            h0,
+            t0,
+        };
+        let (phase, branch) = moments.phase_of(&w_p);
+        let mut z0 = vec![0.0; system.dim()];
+        z0[H] = 1.0;
+        z0[T] = 1.0;
+        z0[PHASE] = phase;
+        for (k, &o) in offsets.iter().enumerate() {
+            z0[EFFECTORS + k] = y0[o] / t0;
+        }
+        let (epsilon, fast) = system.epsilon(&z0);
+        if epsilon.is_nan() || epsilon > MAX_EPSILON {
+            return Err(format!(
+                "method `averaged` needs dissipation slow next to the motion it averages over, \
+                 and here the fast period ({fast:.3e} s) is {epsilon:.2e} of the dissipation \
+                 time (the limit is {MAX_EPSILON:e}); use dop853"
+            ));
+        }
+        let mut stepper = AveragedStepper {
+            system,
+            slow: Dop853::new(
+                0.0,
+                &z0,
+                Tolerances {
+                    rtol: a.rtol,
+                    atol: a.rtol,
+                },
+                a.max_step,
+                None,
+            ),
+            frame_n,
+            branch,
+            branch_before: branch,
+            crossing: None,
+            offsets,
+            y: y0.to_vec(),
+            stats: Stats::default(),
+        };
+        // The precession angle that puts the rebuilt attitude on q0.
+        let mut y = y0.to_vec();
+        stepper.rebuild(&z0, branch, &mut y)?;
+        let q_test = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
+        let d = q0 * q_test.inverse();
+        z0[PRECESSION] = 2.0 * d.imag().dot(&h_hat_n).atan2(d.w);
+        stepper.slow = Dop853::new(
+            0.0,
+            &z0,
+            Tolerances {
+                rtol: a.rtol,
+                atol: a.rtol,
+            },
+            a.max_step,
+            None,
+        );
+        stepper.rebuild(&z0, branch, &mut y)?;
+        stepper.y = y;
+        Ok(stepper)
+    }
+
+    /// The full state at slow state `z` on branch `branch`: ω and q from the exact torque-free
+    /// solution through the reference point, advanced by the polhode phase and turned about
+    /// Ĥ_N by the precession angle, and each effector's dissipated energy.
+    fn rebuild(&self, z: &[f64], branch: f64, out: &mut [f64]) -> Result<(), String> {
+        let s = &self.system;
+        let h = z[H] * s.h0;
+        let energy = z[T] * s.t0;
+        let mut w_p = s.moments.reference_rates(h, energy, branch);
+        // Never the exact pure spin: the closed form's steady case measures precession
+        // differently, so keep a vanishing nutation instead.
+        let floor = 1e-100 * w_p.amax();
+        if w_p.x == 0.0 {
+            w_p.x = floor;
+        }
+        if w_p.z == 0.0 {
+            w_p.z = floor;
+        }
+        let omega_ref = s.axes * w_p;
+        let h_b = s.inertia * omega_ref;
+        let z_b = h_b.normalize();
+        let y_b = s.axes.column(1).into_owned();
+        let x_b = y_b.cross(&z_b);
+        let body = Matrix3::from_columns(&[x_b, y_b, z_b]);
+        let q_ref = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+            self.frame_n * body.transpose(),
+        ));
+        let h_hat_n = Unit::new_unchecked(self.frame_n.column(2).into_owned());
+        let solution = TorqueFreeSolution::new(&s.inertia, &omega_ref, &q_ref)
+            .map_err(|e| format!("the torque-free solution at the slow state failed: {e}"))?;
+        let period = solution.polhode_period();
+        let (omega, q) = if period.is_finite() && period > 0.0 {
+            let frac = z[PHASE].rem_euclid(1.0);
+            let (w, q) = solution.state_at(frac * period);
+            let turn = z[PRECESSION] - frac * solution.precession_angle_per_period();
+            (w, UnitQuaternion::from_axis_angle(&h_hat_n, turn) * q)
+        } else {
+            (
+                omega_ref,
+                UnitQuaternion::from_axis_angle(&h_hat_n, z[PRECESSION]) * q_ref,
+            )
+        };
+        // Keep the quaternion on the hemisphere of the last state, for smooth telemetry.
+        let sign = if q.w * self.y[3] + q.i * self.y[4] + q.j * self.y[5] + q.k * self.y[6] < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        out[..3].copy_from_slice(omega.as_slice());
+        out[3] = sign * q.w;
+        out[4] = sign * q.i;
+        out[5] = sign * q.j;
+        out[6] = sign * q.k;
+        for (k, &o) in self.offsets.iter().enumerate() {
+            out[o] = z[EFFECTORS + k] * s.t0;
+        }
+        Ok(())
+    }
+
+    /// Whether the polhode circulates about axis 3 at slow state `z`.
+    fn about_major(&self, z: &[f64]) -> bool {
+        let s = &self.system;
+        let (_, d2, _) = s.moments.deltas(z[H] * s.h0, z[T] * s.t0);
+        d2 >= 0.0 || s.moments.i[1] == s.moments.i[0]
+    }
+
+    /// The slow state at `t` inside the last step.
+    fn slow_at(&self, t: f64) -> Vec<f64> {
+        let mut z = vec![0.0; self.system.dim()];
+        if t == self.slow.t() {
+            z.copy_from_slice(self.slow.y());
+        } else {
+            self.slow.interpolate(t, &mut z);
+        }
+        z
+    }
+
+    /// After a step from `t0` that changed the circulation: the crossing time, by bisection on
+    /// the dense output, and the branch entered, taken from the rebuilt rates just before it.
+    /// The averaged motion cannot resolve which pole the body falls toward: the fast phase at
+    /// the crossing decides, and the branch follows the rebuilt phase (docs/averaging.md).
+    fn cross_separatrix(&mut self, t0: f64) -> Result<(), String> {
+        let major0 = self.about_major(self.slow_at(t0).as_slice());
+        let (mut a, mut b) = (t0, self.slow.t());
+        for _ in 0..200 {
+            let mid = 0.5 * (a + b);
+            if mid <= a || mid >= b {
+                break;
+            }
+            if self.about_major(&self.slow_at(mid)) == major0 {
+                a = mid;
+            } else {
+                b = mid;
+            }
+        }
+        let mut y = self.y.clone();
+        self.rebuild(&self.slow_at(a), self.branch, &mut y)?;
+        let w_p = self.system.axes.transpose() * Vector3::new(y[0], y[1], y[2]);
+        let toward = if major0 { w_p.x } else { w_p.z };
+        self.branch_before = self.branch;
+        self.branch = if toward < 0.0 { -1.0 } else { 1.0 };
+        self.crossing = Some(b);
+        Ok(())
+    }
+}
+
+/// A right-handed frame whose third column is `z` (unit).
+fn inertial_frame(z: &Vector3<f64>) -> Matrix3<f64> {
+    let least = z.iamin();
+    let mut e = Vector3::zeros();
+    e[least] = 1.0;
+    let x = (e - z * z.dot(&e)).normalize();
+    Matrix3::from_columns(&[x, z.cross(&x), *z])
+}
+
+impl Stepper for AveragedStepper {
+    fn t(&self) -> f64 {
+        self.slow.t()
+    }
+    fn y(&self) -> &[f64] {
+        &self.y
+    }
+    fn t_prev(&self) -> f64 {
+        self.slow.t_prev()
+    }
+    fn step<S: OdeSystem + ?Sized>(&mut self, _sys: &S, t_end: f64) -> Result<f64, StepError> {
+        let t0 = self.slow.t();
+        let z0_major = self.about_major(self.slow.y());
+        self.slow.step(&self.system, t_end)?;
+        let t1 = self.slow.t();
+        self.crossing = None;
+        self.branch_before = self.branch;
+        let sub = |what: String| StepError::SubFlow { t: t0, what };
+        if self.about_major(self.slow.y()) != z0_major {
+            self.cross_separatrix(t0).map_err(sub)?;
+        }
+        let z = self.slow.y().to_vec();
+        let (epsilon, fast) = self.system.epsilon(&z);
+        if epsilon.is_nan() || epsilon > MAX_EPSILON {
+            return Err(sub(format!(
+                "averaging no longer holds at t = {t1:.6e} s: the fast period ({fast:.3e} s) \
+                 has grown to {epsilon:.2e} of the dissipation time (the limit is \
+                 {MAX_EPSILON:e})"
+            )));
+        }
+        let mut y = self.y.clone();
+        self.rebuild(&z, self.branch, &mut y).map_err(sub)?;
+        self.y = y;
+        self.stats = self.slow.stats();
+        Ok(t1)
+    }
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        let branch = match self.crossing {
+            Some(tc) if t < tc => self.branch_before,
+            _ => self.branch,
+        };
+        let z = self.slow_at(t);
+        if self.rebuild(&z, branch, out).is_err() {
+            out.fill(f64::NAN);
+        }
+    }
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
+        // The averaged effectors have no breakpoints and no held states.
+    }
+}
