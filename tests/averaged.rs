@@ -247,3 +247,58 @@ fn auto_never_picks_it() {
         assert!(!matches!(s.method, Method::Averaged(_)), "{path}");
     }
 }
+
+/// `polhode montecarlo FILE --method M --runs N` into a fresh directory; its summary.
+fn campaign(method: &str, runs: u32) -> serde_json::Value {
+    let out = std::env::temp_dir().join(format!(
+        "polhode-averaged-mc-{}-{method}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_polhode"))
+        .args([
+            "montecarlo",
+            "tests/data/montecarlo-averaged.yaml",
+            "--quiet",
+        ])
+        .args(["--method", method, "--runs", &runs.to_string(), "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let _ = std::fs::remove_dir_all(&out);
+    serde_json::from_str(&text).unwrap()
+}
+
+#[test]
+fn an_averaged_campaign_gives_the_full_campaigns_event_probabilities() {
+    let full = campaign("dop853", 60);
+    let averaged = campaign("averaged", 60);
+    assert_eq!(averaged["status"]["complete"], 60);
+    let (fe, ae) = (
+        full["events"].as_array().unwrap(),
+        averaged["events"].as_array().unwrap(),
+    );
+    assert_eq!(fe.len(), 2);
+    for (f, a) in fe.iter().zip(ae) {
+        for (bf, ba) in f["by"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(a["by"].as_array().unwrap())
+        {
+            let p = ba["probability"].as_f64().unwrap();
+            let (lo, hi) = (
+                bf["ci95"][0].as_f64().unwrap(),
+                bf["ci95"][1].as_f64().unwrap(),
+            );
+            assert!(
+                (lo..=hi).contains(&p),
+                "{} by {} s: {p} outside the full campaign's [{lo}, {hi}]",
+                f["condition"],
+                bf["t"]
+            );
+        }
+    }
+}

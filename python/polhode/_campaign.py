@@ -172,6 +172,7 @@ def montecarlo(
     threads: Optional[int] = None,
     shard: Union[str, Tuple[int, int], None] = None,
     progress: Union[bool, None, Callable[[int, int], Any]] = None,
+    method: Optional[str] = None,
 ) -> Campaign:
     """Run the scenario's Monte Carlo campaign (its ``montecarlo:`` block) in process.
 
@@ -185,6 +186,8 @@ def montecarlo(
       Jupyter kernel and tqdm is installed, nothing otherwise; True always (needs tqdm);
       False never; or a callable ``f(done, total)``, called from the calling thread about
       every 0.1 s while the count changes.
+    - ``method``: every run's integration method instead of the scenario's, as ``--method``
+      (e.g. ``"averaged"``, docs/averaging.md).
 
     Returns a :class:`Campaign`. The GIL is released while the runs go. Ctrl-C stops the
     campaign within a fraction of a second and raises ``KeyboardInterrupt`` whose
@@ -197,7 +200,7 @@ def montecarlo(
     report = _progress(progress, name)
     try:
         parquet, summary, partial, raised = _montecarlo(
-            scenario, runs, seed, threads, pair, report
+            scenario, runs, seed, threads, pair, report, method
         )
     finally:
         if isinstance(report, _Bar):

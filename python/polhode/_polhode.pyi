@@ -121,6 +121,7 @@ def _montecarlo(
     threads: Optional[int] = None,
     shard: Optional[Tuple[int, int]] = None,
     on_progress: Optional[Callable[[int, int], object]] = None,
+    method: Optional[str] = None,
 ) -> Tuple[bytes, str, bool, Optional[BaseException]]:
     """Internal: see :func:`polhode.montecarlo`. Returns the ``runs.parquet`` bytes, the
     ``summary.json`` text, whether runs are missing, and the exception raised meanwhile."""

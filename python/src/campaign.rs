@@ -17,7 +17,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 /// `on_progress(done, total)` is called from this thread: once before, then on the 0.1 s
 /// wake-ups when the count changed, and once at the end.
 #[pyfunction]
-#[pyo3(signature = (scenario, runs=None, seed=None, threads=None, shard=None, on_progress=None))]
+#[pyo3(signature = (scenario, runs=None, seed=None, threads=None, shard=None, on_progress=None, method=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub(crate) fn _montecarlo(
     py: Python<'_>,
@@ -27,11 +27,12 @@ pub(crate) fn _montecarlo(
     threads: Option<usize>,
     shard: Option<(u64, u64)>,
     on_progress: Option<Bound<'_, PyAny>>,
+    method: Option<String>,
 ) -> PyResult<(Py<PyBytes>, String, bool, Option<Py<PyAny>>)> {
     let (path, source) = (scenario.path.clone(), scenario.source.clone());
     let prepared = catch_unwind(AssertUnwindSafe(|| {
         let s = scenario::parse(&path, source, &Overrides::default())?;
-        montecarlo::Prepared::new(s, &path.display().to_string(), runs, seed)
+        montecarlo::Prepared::new(s, &path.display().to_string(), runs, seed)?.with_method(method)
     }))
     .map_err(|p| internal_error("preparing the campaign", p.as_ref()))?;
     let prep = prepared.map_err(|e| scenario_error(py, &e))?;

@@ -60,6 +60,17 @@ def test_a_shard_equals_the_cli_shard(polhode_cli, tmp_path, shard):
     assert campaign.table.column("run").to_pylist() == list(range(10, 20))
 
 
+def test_the_averaged_method_equals_the_cli_with_method(polhode_cli, tmp_path):
+    out = cli_campaign(polhode_cli, tmp_path / "avg", "--seed", "3", "--runs", "40", "--method", "averaged")
+    campaign = polhode.montecarlo(polhode.load(SINK), runs=40, seed=3, method="averaged")
+    assert campaign.parquet == (out / "runs.parquet").read_bytes()
+    assert campaign.summary == json.loads((out / "summary.json").read_text())
+    full = polhode.montecarlo(polhode.load(SINK), runs=40, seed=3)
+    assert campaign.table.column("steps").to_pylist() != full.table.column("steps").to_pylist()
+    with pytest.raises(polhode.ScenarioError, match="unknown method"):
+        polhode.montecarlo(polhode.load(SINK), runs=4, method="avergaed")
+
+
 def test_to_pandas_is_the_table():
     pytest.importorskip("pandas")
     campaign = polhode.montecarlo(polhode.load(SINK), runs=10)

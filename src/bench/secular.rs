@@ -177,3 +177,107 @@ pub fn compare(
         energy_error,
     })
 }
+
+/// One point of the long-horizon work-precision chart.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PrecisionPoint {
+    /// `dop853` or `averaged`.
+    pub method: String,
+    /// Its rtol.
+    pub rtol: f64,
+    /// Fastest timed run (s): events, no output sampling.
+    pub seconds: f64,
+    /// Largest relative error of T over the times asked, against the reference.
+    pub energy_error: f64,
+    /// Largest relative error of the events' first times, against the reference.
+    pub event_error: f64,
+}
+
+/// Work-precision on a long-horizon dissipating scene: the largest relative error of the
+/// kinetic energy at `times` (and of the event times) against dop853 at rtol 1e-12, against
+/// the wall time of the run with its events, for dop853 and `averaged` each over a range of
+/// rtol. Writes `long-horizon-<stem>.svg|png|csv` into `out`; returns the files.
+pub fn long_horizon(
+    path: &Path,
+    times: &[f64],
+    out: &Path,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<std::path::PathBuf>, String> {
+    use crate::plot::{Chart, Scale, Series, Style};
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "scene".into());
+    progress(&format!("{stem}: reference (dop853, rtol 1e-12)"));
+    let reference = load(path, "dop853", Some(1e-12))?;
+    let conditions: Vec<String> = reference.events.iter().map(|c| c.describe()).collect();
+    let reference = side(reference, &conditions, times, 1)?;
+    let mut points = Vec::new();
+    let sweeps: [(&str, &[f64]); 2] = [
+        ("dop853", &[1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]),
+        (
+            "averaged",
+            &[1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10],
+        ),
+    ];
+    for (method, rtols) in sweeps {
+        for &rtol in rtols {
+            let s = load(path, method, Some(rtol))?;
+            let r = side(s, &conditions, times, 3)?;
+            let energy_error = r
+                .kinetic_energy
+                .iter()
+                .zip(&reference.kinetic_energy)
+                .map(|(a, f)| ((a - f) / f).abs())
+                .fold(0.0, f64::max);
+            let event_error = r
+                .first_events
+                .iter()
+                .zip(&reference.first_events)
+                .filter_map(|(a, f)| Some(((a.as_ref()? - f.as_ref()?) / f.as_ref()?).abs()))
+                .fold(0.0, f64::max);
+            progress(&format!(
+                "{stem}: {method} rtol {rtol:e} → T {energy_error:.1e}, events \
+                 {event_error:.1e} in {:.3e} s",
+                r.seconds
+            ));
+            points.push(PrecisionPoint {
+                method: method.into(),
+                rtol,
+                seconds: r.seconds,
+                energy_error,
+                event_error,
+            });
+        }
+    }
+    let mut chart = Chart::new(
+        format!("Long horizon: {stem}"),
+        "wall time of the run with its events (s), fastest of 3",
+        "largest relative error of T at the compared times",
+    );
+    chart.x_scale = Scale::Log10;
+    chart.y_scale = Scale::Log10;
+    for method in ["dop853", "averaged"] {
+        let pts: Vec<(f64, f64)> = points
+            .iter()
+            .filter(|p| p.method == method)
+            .map(|p| (p.seconds, p.energy_error.max(1e-16)))
+            .collect();
+        chart
+            .series
+            .push(Series::new(method, pts, Style::LineMarkers));
+    }
+    let base = out.join(format!("long-horizon-{stem}"));
+    let mut files = crate::plot::svg_and_png(&chart, &base)?;
+    let mut csv = String::from("method,rtol,seconds,energy_error,event_error\n");
+    for p in &points {
+        csv.push_str(&format!(
+            "{},{:e},{:e},{:e},{:e}\n",
+            p.method, p.rtol, p.seconds, p.energy_error, p.event_error
+        ));
+    }
+    let path = base.with_extension("csv");
+    std::fs::write(&path, csv).map_err(|e| format!("{}: {e}", path.display()))?;
+    files.push(path);
+    Ok(files)
+}

@@ -81,6 +81,10 @@ pub(super) enum Command {
         /// scenarios' own `events:` as the columns.
         #[arg(long = "event", value_name = "CONDITION")]
         events: Vec<String>,
+        /// Run every scenario with this method instead of its own; repeatable (one row per
+        /// scenario and method, e.g. `--method dop853 --method averaged`).
+        #[arg(long = "method", value_name = "METHOD")]
+        methods: Vec<String>,
     },
     /// Benchmarks of the integration methods (docs/choosing-a-method.md).
     Bench {
@@ -107,6 +111,9 @@ pub(super) enum Command {
         /// Output directory (default `logs/<name>-montecarlo`, or `…/shard-K` for a shard).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Integration method of every run instead of the scenario's (e.g. `averaged`).
+        #[arg(long)]
+        method: Option<String>,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
@@ -199,6 +206,18 @@ pub(super) enum BenchCommand {
         /// Timed runs of each method; the fastest counts.
         #[arg(long, default_value_t = 5)]
         repeats: usize,
+    },
+    /// Long-horizon work-precision: T's error against wall time for dop853 and averaged on
+    /// dissipating scenes (charts and CSV).
+    LongHorizon {
+        /// Scenario YAML files.
+        #[arg(required = true)]
+        scenarios: Vec<PathBuf>,
+        /// Times (s, on each scene's output grid) at which T is compared.
+        #[arg(long, value_delimiter = ',', required = true)]
+        times: Vec<f64>,
+        #[command(flatten)]
+        out: OutArgs,
     },
     /// Error growth of every method near the separatrix, with the problem's conditioning.
     Separatrix {

@@ -55,6 +55,32 @@ pub(super) fn bench_cmd(what: BenchCommand) -> i32 {
             }
             0
         }
+        BenchCommand::LongHorizon {
+            scenarios,
+            times,
+            out,
+        } => {
+            if times.iter().any(|t| !(t.is_finite() && *t >= 0.0)) {
+                eprintln!("error: --times: expected non-negative times in seconds");
+                return EXIT_BAD_INPUT;
+            }
+            if let Err(code) = make_dir(&out.out) {
+                return code;
+            }
+            let mut files = Vec::new();
+            for path in &scenarios {
+                match crate::bench::secular::long_horizon(
+                    path,
+                    &times,
+                    &out.out,
+                    bench_progress(out.quiet),
+                ) {
+                    Ok(f) => files.extend(f),
+                    Err(e) => return report_files(Err(e), out.quiet),
+                }
+            }
+            report_files(Ok(files), out.quiet)
+        }
         BenchCommand::Drift { duration, out } => {
             if !(duration.is_finite() && duration > 0.0) {
                 eprintln!("error: --duration: expected a positive number of seconds");

@@ -16,10 +16,13 @@ pub(super) fn compare_cmd(
     json: Option<&Path>,
     duration: Option<f64>,
     events: &[String],
+    methods: &[String],
 ) -> i32 {
-    let overrides = Overrides {
-        duration,
-        ..Overrides::default()
+    // Each scenario with each `--method` (or its own).
+    let methods: Vec<Option<String>> = if methods.is_empty() {
+        vec![None]
+    } else {
+        methods.iter().cloned().map(Some).collect()
     };
     // Validate everything before running anything.
     let mut option_events = Vec::new();
@@ -34,9 +37,22 @@ pub(super) fn compare_cmd(
     }
     let mut scenarios = Vec::new();
     for p in paths {
-        match load(p, &overrides) {
-            Ok(s) => scenarios.push(s),
-            Err(c) => return c,
+        for method in &methods {
+            let overrides = Overrides {
+                duration,
+                method: method.clone(),
+                ..Overrides::default()
+            };
+            match load(p, &overrides) {
+                Ok(mut s) => {
+                    if methods.len() > 1 {
+                        // One row per method: the rows are told apart by it.
+                        s.name = format!("{} [{}]", s.name, s.method.name());
+                    }
+                    scenarios.push(s)
+                }
+                Err(c) => return c,
+            }
         }
     }
     let columns = crate::compare::Columns::new(&scenarios, &option_events);

@@ -93,6 +93,7 @@ pub fn main() -> i32 {
             json,
             duration,
             events,
+            methods,
         } => compare::compare_cmd(
             &scenarios,
             chart.as_deref(),
@@ -100,6 +101,7 @@ pub fn main() -> i32 {
             json.as_deref(),
             duration,
             &events,
+            &methods,
         ),
         Command::Linearize { scenario, json } => {
             linearize::linearize_cmd(&scenario, json.as_deref())
@@ -111,10 +113,20 @@ pub fn main() -> i32 {
             threads,
             shard,
             out,
+            method,
             quiet,
-        } => {
-            montecarlo::montecarlo_cmd(&scenario, runs, seed, threads, shard.as_deref(), out, quiet)
-        }
+        } => montecarlo::montecarlo_cmd(
+            &scenario,
+            montecarlo::Options {
+                runs,
+                seed,
+                threads,
+                shard: shard.as_deref(),
+                out,
+                method,
+                quiet,
+            },
+        ),
         Command::Merge { dirs, out, quiet } => montecarlo::merge_cmd(&dirs, &out, quiet),
         Command::Plot { log, out, quiet } => plot::plot_cmd(&log, out, quiet),
         Command::Bench { what } => bench::bench_cmd(what),

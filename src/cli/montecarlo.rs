@@ -27,18 +27,30 @@ struct CampaignProgress {
     failed: u64,
 }
 
+/// The options of `polhode montecarlo`.
+pub(super) struct Options<'a> {
+    pub(super) runs: Option<u64>,
+    pub(super) seed: Option<u64>,
+    pub(super) threads: Option<usize>,
+    pub(super) shard: Option<&'a str>,
+    pub(super) out: Option<PathBuf>,
+    pub(super) method: Option<String>,
+    pub(super) quiet: bool,
+}
+
 /// Runs a campaign (or one shard of it) and writes its outputs into `out`.
-pub(super) fn montecarlo_cmd(
-    path: &Path,
-    runs: Option<u64>,
-    seed: Option<u64>,
-    threads: Option<usize>,
-    shard: Option<&str>,
-    out: Option<PathBuf>,
-    quiet: bool,
-) -> i32 {
+pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
     use crate::montecarlo;
-    let prep = match montecarlo::load(path, runs, seed) {
+    let Options {
+        runs,
+        seed,
+        threads,
+        shard,
+        out,
+        method,
+        quiet,
+    } = options;
+    let prep = match montecarlo::load_with_method(path, runs, seed, method) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");

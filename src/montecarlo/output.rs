@@ -130,6 +130,9 @@ pub struct Manifest {
     pub columns: Vec<String>,
     /// Hex SHA-256 of `runs.csv`.
     pub runs_csv_sha256: String,
+    /// The method that replaced the scenario's (`--method`), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<String>,
 }
 
 /// `summary.json`.
@@ -243,6 +246,7 @@ fn manifest(
         partial,
         columns: prep.columns.clone(),
         runs_csv_sha256: sha256_hex(csv.as_bytes()),
+        method: prep.method.clone(),
     }
 }
 
@@ -847,6 +851,7 @@ pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
         Some(m0.runs),
         Some(m0.seed),
     )
+    .and_then(|p| p.with_method(m0.method.clone()))
     .map_err(|e| format!("the shards' campaign no longer loads: {e}"))?;
     if prep.columns != m0.columns {
         return Err("the shards were written with other table columns".into());
