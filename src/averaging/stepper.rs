@@ -213,16 +213,7 @@ impl AveragedStepper {
         }
         let mut stepper = AveragedStepper {
             system,
-            slow: Dop853::new(
-                0.0,
-                &z0,
-                Tolerances {
-                    rtol: a.rtol,
-                    atol: a.rtol,
-                },
-                a.max_step,
-                None,
-            ),
+            slow: slow_stepper(&z0, &a),
             frame_n,
             branch,
             branch_before: branch,
@@ -237,16 +228,7 @@ impl AveragedStepper {
         let q_test = UnitQuaternion::from_quaternion(Quaternion::new(y[3], y[4], y[5], y[6]));
         let d = q0 * q_test.inverse();
         z0[PRECESSION] = 2.0 * d.imag().dot(&h_hat_n).atan2(d.w);
-        stepper.slow = Dop853::new(
-            0.0,
-            &z0,
-            Tolerances {
-                rtol: a.rtol,
-                atol: a.rtol,
-            },
-            a.max_step,
-            None,
-        );
+        stepper.slow = slow_stepper(&z0, &a);
         stepper.rebuild(&z0, branch, &mut y)?;
         stepper.y = y;
         Ok(stepper)
@@ -355,6 +337,16 @@ impl AveragedStepper {
         self.crossing = Some(b);
         Ok(())
     }
+}
+
+/// DOP853 on the slow system from `z0` at t = 0: `a.rtol` on the variables scaled by their
+/// initial values, so the same number serves as the absolute tolerance.
+fn slow_stepper(z0: &[f64], a: &Adaptive) -> Dop853 {
+    let tolerances = Tolerances {
+        rtol: a.rtol,
+        atol: a.rtol,
+    };
+    Dop853::new(0.0, z0, tolerances, a.max_step, None)
 }
 
 /// A right-handed frame whose third column is `z` (unit).
