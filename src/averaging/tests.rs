@@ -123,3 +123,55 @@ fn on_the_separatrix_the_body_sits_at_the_intermediate_axis() {
 fn a_spherical_body_has_nothing_to_average() {
     assert!(Moments::new(&Vector3::new(2.0, 2.0, 2.0)).is_none());
 }
+
+#[test]
+#[ignore]
+fn explore_explorer1_forced_response() {
+    use super::forced::{Layout, periodic_response};
+    let s = crate::scenario::load(
+        std::path::Path::new("scenarios/explorer1.yaml"),
+        &crate::scenario::Overrides::default(),
+    )
+    .unwrap();
+    let sc = &s.spacecraft;
+    let y0 = sc.initial_state(&s.omega0, &s.attitude0);
+    let j = sc.system_inertia(&y0);
+    let body = crate::model::RigidBody::new(j).unwrap();
+    let moments = Moments::new(&body.principal_moments).unwrap();
+    let mut layout = Layout {
+        dynamic: vec![],
+        dissipated: vec![],
+    };
+    for (k, e) in sc.effectors().iter().enumerate() {
+        let o = sc.effector_offset(k);
+        let d = e.num_dynamic_states();
+        layout.dynamic.extend(o..o + d);
+        layout.dissipated.push(o + d);
+    }
+    let w_p = body.principal_axes.transpose() * s.omega0;
+    let [i1, i2, i3] = moments.i;
+    let h = Vector3::new(i1 * w_p.x, i2 * w_p.y, i3 * w_p.z).norm();
+    println!("J_c moments {:?}, h {h}", moments.i);
+    let mut guess = vec![0.0; layout.dynamic.len()];
+    for deg in [2.67f64, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 70.0, 80.0, 85.0, 88.0] {
+        let th = deg.to_radians();
+        // Symmetric about axis 1 (the spin axis has the least moment): cos θ = I1 ω1 / h.
+        let t = 0.5 * h * h * (th.cos().powi(2) / i1 + th.sin().powi(2) / i3);
+        let w_ref = body.principal_axes * moments.reference_rates(h, t, 1.0);
+        let start = std::time::Instant::now();
+        match periodic_response(sc, &y0, &layout, &j, &w_ref, &guess, 1e-9) {
+            Ok((r, x)) => {
+                let p: f64 = r.powers.iter().sum();
+                println!(
+                    "θ {deg:5.2}° T {t:10.4} P {:.4} s power {p:.6e} W  iters {} res {:.1e}  {:.1} ms",
+                    r.period,
+                    r.iterations,
+                    r.residual,
+                    start.elapsed().as_secs_f64() * 1e3
+                );
+                guess = x;
+            }
+            Err(e) => println!("θ {deg}°: {e}"),
+        }
+    }
+}
