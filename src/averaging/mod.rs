@@ -9,6 +9,7 @@
 //! - [`stepper`]: the slow system stepped by DOP853, and the full state rebuilt from the exact
 //!   solution for sampling, events and logs.
 
+pub mod forced;
 pub mod motion;
 pub mod stepper;
 

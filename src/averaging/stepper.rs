@@ -117,6 +117,8 @@ pub struct AveragedStepper {
     crossing: Option<f64>,
     /// Offsets of each effector's dissipated energy in the state vector.
     offsets: Vec<usize>,
+    /// The initial state: the effectors' dynamic states are shown as they started.
+    rest: Vec<f64>,
     y: Vec<f64>,
     stats: Stats,
 }
@@ -130,13 +132,21 @@ pub fn refusal(sc: &Spacecraft) -> Option<String> {
                 .into(),
         );
     }
+    let internal = sc.effectors().iter().any(|e| e.num_dynamic_states() > 0);
     for e in sc.effectors() {
-        if e.secular().is_some() {
+        if e.secular().is_some() && !internal {
             continue;
         }
-        let why = if e.num_dynamic_states() > 0 {
-            "has internal degrees of freedom; averaging them needs their periodic forced \
-             response along the torque-free motion, which polhode does not compute yet"
+        if internal && is_internal(e.as_ref()) {
+            continue;
+        }
+        let why = if internal && e.secular().is_some() {
+            "is a torque, and this spacecraft also has effectors with internal degrees of \
+             freedom: averaging the two kinds together is not implemented"
+        } else if e.num_dynamic_states() > 0 {
+            "has internal degrees of freedom that have no conservative counterpart to average \
+             its dissipation over (only spring–mass dampers, hinged rods and modal appendages \
+             do)"
         } else {
             "applies an environmental or control torque, which does not average over the \
              torque-free motion (it depends on the orbit, the field or a controller's state)"
@@ -150,6 +160,15 @@ pub fn refusal(sc: &Spacecraft) -> Option<String> {
     None
 }
 
+/// An effector whose dissipation is averaged over the coupled periodic orbits
+/// ([`super::forced`]): dynamic states, then one bookkeeping state (the energy it dissipated),
+/// and a conservative counterpart.
+fn is_internal(e: &dyn crate::model::Effector) -> bool {
+    e.num_dynamic_states() > 0
+        && e.num_states() == e.num_dynamic_states() + 1
+        && e.without_dissipation().is_some()
+}
+
 impl AveragedStepper {
     /// Starts at `(0, y0)` with the tolerances `a` on the slow variables; `Err` (a diagnosis)
     /// when the spacecraft or the initial state cannot be averaged.
@@ -157,15 +176,25 @@ impl AveragedStepper {
         if let Some(why) = refusal(sc) {
             return Err(why);
         }
-        let Some(moments) = Moments::new(&sc.hub.principal_moments) else {
+        // With internal degrees of freedom the averaged body is the spacecraft locked in its
+        // initial configuration, and the effectors' dissipation comes from a table of the
+        // coupled periodic orbits.
+        let internal = sc.effectors().iter().any(|e| e.num_dynamic_states() > 0);
+        let hub = if internal {
+            crate::model::RigidBody::new(sc.system_inertia(y0))
+                .map_err(|e| format!("the locked spacecraft's inertia: {e}"))?
+        } else {
+            sc.hub.clone()
+        };
+        let Some(moments) = Moments::new(&hub.principal_moments) else {
             return Err(
                 "method `averaged`: the body is spherical, so its rates never change and there \
                  is nothing to average; use exact or dop853"
                     .into(),
             );
         };
-        let inertia = sc.hub.inertia;
-        let axes = sc.hub.principal_axes;
+        let inertia = hub.inertia;
+        let axes = hub.principal_axes;
         let omega0 = Vector3::new(y0[0], y0[1], y0[2]);
         let q0 = UnitQuaternion::from_quaternion(Quaternion::new(y0[3], y0[4], y0[5], y0[6]));
         let w_p = axes.transpose() * omega0;
@@ -182,11 +211,39 @@ impl AveragedStepper {
         }
         let h_hat_n = q0 * (axes * h_p) / h0;
         let frame_n = inertial_frame(&h_hat_n);
-        let effects: Vec<Box<dyn Secular>> =
-            sc.effectors().iter().filter_map(|e| e.secular()).collect();
-        let offsets: Vec<usize> = (0..sc.effectors().len())
-            .map(|k| sc.effector_offset(k))
+        // Where each effector's dissipated energy is: after its dynamic states.
+        let offsets: Vec<usize> = sc
+            .effectors()
+            .iter()
+            .enumerate()
+            .map(|(k, e)| sc.effector_offset(k) + e.num_dynamic_states())
             .collect();
+        let effects: Vec<Box<dyn Secular>> = if internal {
+            let mut layout = super::forced::Layout {
+                dynamic: Vec::new(),
+                dissipated: offsets.clone(),
+            };
+            for (k, e) in sc.effectors().iter().enumerate() {
+                let o = sc.effector_offset(k);
+                layout.dynamic.extend(o..o + e.num_dynamic_states());
+            }
+            let table = std::sync::Arc::new(super::forced::DissipationTable::new(
+                sc,
+                y0,
+                &layout,
+                (1e-2 * a.rtol).clamp(1e-11, 1e-8),
+            )?);
+            (0..sc.effectors().len())
+                .map(|index| {
+                    Box::new(super::forced::Tabulated {
+                        table: table.clone(),
+                        index,
+                    }) as Box<dyn Secular>
+                })
+                .collect()
+        } else {
+            sc.effectors().iter().filter_map(|e| e.secular()).collect()
+        };
         let system = SlowSystem {
             moments,
             axes,
@@ -219,6 +276,7 @@ impl AveragedStepper {
             branch_before: branch,
             crossing: None,
             offsets,
+            rest: y0.to_vec(),
             y: y0.to_vec(),
             stats: Stats::default(),
         };
@@ -281,6 +339,7 @@ impl AveragedStepper {
         } else {
             1.0
         };
+        out.copy_from_slice(&self.rest);
         out[..3].copy_from_slice(omega.as_slice());
         out[3] = sign * q.w;
         out[4] = sign * q.i;

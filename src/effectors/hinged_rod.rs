@@ -106,6 +106,12 @@ impl ParticleModel for HingedRod {
     fn kind(&self) -> &'static str {
         "hinged_rod"
     }
+    fn undamped(&self) -> Self {
+        HingedRod {
+            damping: [0.0; 2],
+            ..self.clone()
+        }
+    }
     fn num_coordinates(&self) -> usize {
         match self.freedom {
             HingeFreedom::FlapLag => 2,

@@ -151,6 +151,12 @@ impl ParticleModel for ModalBeam {
     fn kind(&self) -> &'static str {
         "modal_appendage"
     }
+    fn undamped(&self) -> Self {
+        ModalBeam {
+            damping_ratio: 0.0,
+            ..self.clone()
+        }
+    }
     fn num_coordinates(&self) -> usize {
         self.bending.len() * self.n_modes()
     }

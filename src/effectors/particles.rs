@@ -60,6 +60,10 @@ impl Default for ParticlePoint {
 pub trait ParticleModel: Debug + Send + Sync {
     /// What is shared by all particles at given coordinates and rates (computed once).
     type Cache: Default;
+    /// The same model with its dashpots removed (for the averaged method's undamped orbits).
+    fn undamped(&self) -> Self
+    where
+        Self: Sized;
     /// Computes the shared part of the kinematics at coordinates `q` and rates `u`.
     fn prepare(&self, _q: &[f64], _u: &[f64]) -> Self::Cache {
         Self::Cache::default()
@@ -195,7 +199,14 @@ fn cholesky_solve_many(l: &[f64], n: usize, b: &mut [f64], m: usize) {
     }
 }
 
-impl<P: ParticleModel> Effector for ParticleEffector<P> {
+impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
+    fn without_dissipation(&self) -> Option<Box<dyn Effector>> {
+        Some(Box::new(ParticleEffector {
+            name: self.name.clone(),
+            model: self.model.undamped(),
+            initial: self.initial.clone(),
+        }))
+    }
     fn name(&self) -> &str {
         &self.name
     }

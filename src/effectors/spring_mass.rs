@@ -35,6 +35,12 @@ impl ParticleModel for SpringMass {
     fn kind(&self) -> &'static str {
         "spring_mass_damper"
     }
+    fn undamped(&self) -> Self {
+        SpringMass {
+            damping: 0.0,
+            ..self.clone()
+        }
+    }
     fn num_coordinates(&self) -> usize {
         1
     }

@@ -293,6 +293,12 @@ pub trait Effector: Debug + Send + Sync {
     fn secular(&self) -> Option<Box<dyn Secular>> {
         None
     }
+    /// The same effector with its dissipation removed, in its initial state: the conservative
+    /// system whose periodic orbits `method: averaged` averages the dissipation over. `None`
+    /// (the default) when it has none to remove or cannot say.
+    fn without_dissipation(&self) -> Option<Box<dyn Effector>> {
+        None
+    }
     /// Whether its [`Effector::couple`] only adds a torque: nothing in the mass matrix, no
     /// translation. A scene of such effectors solves the hub with its constant inverse
     /// inertia instead of the general coupled system.
