@@ -66,7 +66,14 @@ pub struct Layout {
 }
 
 /// Integrates `y` over [0, `period`] under `system`.
-fn flow(system: &Driven, y: &mut [f64], period: f64, rtol: f64) -> Result<(), String> {
+/// `what` names the system in an error.
+fn flow<S: OdeSystem>(
+    system: &S,
+    y: &mut [f64],
+    period: f64,
+    rtol: f64,
+    what: &str,
+) -> Result<(), String> {
     let tol = Tolerances {
         rtol,
         atol: rtol * 1e-3,
@@ -75,7 +82,7 @@ fn flow(system: &Driven, y: &mut [f64], period: f64, rtol: f64) -> Result<(), St
     while stepper.t() < period {
         stepper
             .step(system, period)
-            .map_err(|e| format!("the driven effectors could not be integrated: {e}"))?;
+            .map_err(|e| format!("{what} could not be integrated: {e}"))?;
     }
     y.copy_from_slice(stepper.y());
     Ok(())
@@ -121,7 +128,7 @@ pub fn periodic_response(
     };
     let map = |x: &[f64]| -> Result<Vec<f64>, String> {
         let mut y = start(x);
-        flow(&system, &mut y, period, rtol)?;
+        flow(&system, &mut y, period, rtol, "the driven effectors")?;
         Ok(y)
     };
     let mut x = guess.to_vec();
@@ -246,20 +253,10 @@ pub fn coupled_orbit(
         rtol,
         atol: rtol * 1e-3,
     };
-    let integrate = |y: &mut Vec<f64>, period: f64| -> Result<(), String> {
-        let mut stepper = Dop853::new(0.0, y, tol, f64::INFINITY, None).with_dense_output(false);
-        while stepper.t() < period {
-            stepper
-                .step(free, period)
-                .map_err(|e| format!("the undamped spacecraft could not be integrated: {e}"))?;
-        }
-        y.copy_from_slice(stepper.y());
-        Ok(())
-    };
     let residuals = |v: &[f64]| -> Result<Vec<f64>, String> {
         let y_start = start(v);
         let mut y = y_start.clone();
-        integrate(&mut y, v[3 + n])?;
+        flow(free, &mut y, v[3 + n], rtol, "the undamped spacecraft")?;
         let inv = free.invariants(0.0, &y_start);
         let mut r = Vec::with_capacity(rows);
         for c in 0..3 {
