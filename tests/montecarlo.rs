@@ -787,3 +787,79 @@ effectors:
         "{norms:?}"
     );
 }
+
+/// A campaign larger than a block of runs (`BLOCK_RUNS`), than the CDF's exact staircase and
+/// than the scatter's points streams the same files as its shards merged, and its summary
+/// equals the statistics of its table computed here by sorting.
+#[test]
+fn a_campaign_of_many_blocks_streams_the_result_of_its_shards() {
+    let dir = scratch("blocks");
+    let scene = "scenarios/explorer1-energy-sink.yaml";
+    let runs = "9000";
+    let whole = dir.join("whole");
+    let common = ["--method", "averaged", "--runs", runs, "--threads", "2"];
+    campaign(&[&[scene][..], &common[..]].concat(), &whole);
+    let shards: Vec<PathBuf> = (1..=2).map(|k| dir.join(format!("shard-{k}"))).collect();
+    for (k, s) in shards.iter().enumerate() {
+        let spec = format!("{}/2", k + 1);
+        campaign(
+            &[&[scene][..], &common[..], &["--shard", &spec]].concat(),
+            s,
+        );
+    }
+    let merged = dir.join("merged");
+    let o = merge(&[&shards[1], &shards[0]], &merged);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_same(&whole, &merged);
+
+    let manifest = json(&whole.join("campaign.json"));
+    let columns: Vec<String> = manifest["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    let table = polhode::montecarlo::table::from_csv(
+        &std::fs::read_to_string(whole.join("runs.csv")).unwrap(),
+        &columns,
+    )
+    .unwrap();
+    assert_eq!(table.len(), 9000);
+    let summary = json(&whole.join("summary.json"));
+    for stats in summary["columns"].as_array().unwrap() {
+        let name = stats["column"].as_str().unwrap();
+        let j = columns.iter().position(|c| c == name).unwrap();
+        let mut v: Vec<f64> = table
+            .iter()
+            .filter(|r| r.status.ok())
+            .filter_map(|r| r.values[j])
+            .filter(|x| x.is_finite())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        assert_eq!(stats["count"], v.len(), "{name}");
+        assert_eq!(stats["min"].as_f64().unwrap(), v[0], "{name}");
+        assert_eq!(stats["max"].as_f64().unwrap(), v[v.len() - 1], "{name}");
+        for (k, p) in [1.0, 5.0, 25.0, 50.0, 75.0, 95.0, 99.0].iter().enumerate() {
+            let expected = polhode::montecarlo::percentile(&v, *p);
+            assert_eq!(
+                stats["percentiles"][k].as_f64().unwrap(),
+                expected,
+                "{name} p{p}"
+            );
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let got = stats["mean"].as_f64().unwrap();
+        assert!(
+            (got - mean).abs() <= 1e-12 * mean.abs().max(1e-300),
+            "{name}: {got} {mean}"
+        );
+    }
+    // More flat spins than the scatter shows: it says which share it draws.
+    let scatter =
+        std::fs::read_to_string(whole.join("t_nutation_angle_deg_above_45_vs_transverse_rate.svg"))
+            .unwrap();
+    assert!(
+        scatter.contains("1 in 2 of"),
+        "the scatter's title names its thinning"
+    );
+}

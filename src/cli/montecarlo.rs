@@ -84,21 +84,6 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         Some([k, n]) => montecarlo::shard_range(prep.campaign.runs, k, n),
         None => 0..prep.campaign.runs,
     };
-    // The table is held in memory until the outputs are written: refuse up front a campaign
-    // whose table cannot fit, rather than fail (or swap) hours later.
-    let need_mib = (range.end - range.start) as f64 * TABLE_BYTES_PER_RUN / 1048576.0 + 50.0;
-    if let Some(available) = available_memory_mib()
-        && need_mib > 0.8 * available
-    {
-        eprintln!(
-            "error: {}: {} runs need about {need_mib:.0} MiB for the campaign's table, and this \
-             machine has {available:.0} MiB available; split the campaign into shards \
-             (--shard K/N, docs/cluster.md), each holding its own runs only",
-            path.display(),
-            range.end - range.start
-        );
-        return EXIT_BAD_INPUT;
-    }
     let dir = out.unwrap_or_else(|| {
         let base = PathBuf::from("logs").join(format!("{}-montecarlo", prep.scenario.name));
         match shard {
@@ -110,11 +95,15 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         eprintln!("error: cannot write to {}: {e}", dir.display());
         return EXIT_BAD_INPUT;
     }
-    // A previous campaign's files go first, so a run that dies leaves no stale manifest.
-    if let Err(e) = crate::montecarlo::output::clear_outputs(&dir) {
-        eprintln!("error: {e}");
-        return EXIT_BAD_INPUT;
-    }
+    // A previous campaign's files go first, so a run that dies leaves no stale manifest; the
+    // tables are then written as the runs finish.
+    let mut writer = match montecarlo::output::CampaignWriter::create(&dir, &prep, shard) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     let interrupt = campaign_interrupt();
     let total = range.end - range.start;
     if !quiet {
@@ -165,37 +154,41 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         }
     };
     let started = std::time::Instant::now();
-    let result = prep.execute(range, threads, &interrupt, &on_row);
+    let result = prep.execute_streaming(range, threads, &interrupt, &on_row, &mut |row| {
+        writer.push(row)
+    });
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let (rows, partial) = match result {
-        Ok(x) => x,
+    let partial = match result {
+        Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!(
+                "error: {e}; nothing was kept (a re-run with the same seed writes the same result)"
+            );
             return EXIT_IO;
         }
     };
     let seconds = started.elapsed().as_secs_f64();
-    if rows.is_empty() && partial {
+    let rows = writer.rows();
+    if rows == 0 && partial {
         eprintln!("interrupted before any run finished; nothing was written");
         return EXIT_INTERRUPTED;
     }
     WRITING_OUTPUTS.store(true, Ordering::SeqCst);
-    let written =
-        match montecarlo::output::write_outputs(&dir, &prep, &rows, shard, partial, &interrupt) {
-            Ok(w) => w,
-            Err(e) => {
-                eprintln!(
-                    "error: {e}; the campaign's outputs in {} are incomplete: the files written \
-                     before this one are whole, but the manifest campaign.json was not written, \
-                     so `merge` refuses the directory (a re-run with the same seed writes the \
-                     same result)",
-                    dir.display()
-                );
-                return EXIT_IO;
-            }
-        };
+    let written = match writer.finish(partial, &interrupt) {
+        Ok(w) => w,
+        Err(e) => {
+            eprintln!(
+                "error: {e}; the campaign's outputs in {} are incomplete: the files written \
+                 before this one are whole, but the manifest campaign.json was not written, \
+                 so `merge` refuses the directory (a re-run with the same seed writes the \
+                 same result)",
+                dir.display()
+            );
+            return EXIT_IO;
+        }
+    };
     if !quiet {
         if let Ok(text) = std::fs::read_to_string(dir.join("summary.txt")) {
             print!("{text}");
@@ -203,17 +196,15 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         let memory =
             peak_memory_mib().map_or(String::new(), |m| format!(", peak memory {m:.0} MiB"));
         eprintln!(
-            "{} runs in {seconds:.2} s ({:.2} runs/s on {threads} thread(s){memory}) → {}",
-            rows.len(),
-            rows.len() as f64 / seconds.max(1e-9),
+            "{rows} runs in {seconds:.2} s ({:.2} runs/s on {threads} thread(s){memory}) → {}",
+            rows as f64 / seconds.max(1e-9),
             dir.display()
         );
     }
     if partial {
         eprintln!(
-            "interrupted: {} of {total} runs finished; the result in {} is marked partial \
+            "interrupted: {rows} of {total} runs finished; the result in {} is marked partial \
              (no campaign.mcap)",
-            rows.len(),
             dir.display()
         );
         return EXIT_INTERRUPTED;
@@ -250,26 +241,22 @@ fn campaign_interrupt() -> Arc<AtomicBool> {
 /// Combines the shards' outputs in `dirs` into the whole campaign's, in `out`.
 pub(super) fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
     use crate::montecarlo;
-    let (prep, rows) = match montecarlo::output::merge(dirs) {
-        Ok(x) => x,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return EXIT_BAD_INPUT;
-        }
-    };
     let interrupt = campaign_interrupt();
     WRITING_OUTPUTS.store(true, Ordering::SeqCst);
-    let written =
-        match montecarlo::output::write_outputs(out, &prep, &rows, None, false, &interrupt) {
-            Ok(w) => w,
-            Err(e) => {
-                eprintln!(
-                    "error: {e}; the merged result in {} is incomplete (no campaign.json)",
-                    out.display()
-                );
-                return EXIT_IO;
-            }
-        };
+    let (written, rows) = match montecarlo::output::merge(dirs, out, &interrupt) {
+        Ok(x) => x,
+        Err(e) => {
+            // Refusals come before anything is written; a failure after that leaves no
+            // manifest.
+            let code = if out.join("campaign.json").exists() || !e.starts_with("cannot write") {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_IO
+            };
+            eprintln!("error: {e}");
+            return code;
+        }
+    };
     if written.mcap_interrupted {
         eprintln!(
             "interrupted: the merged result is in {}, but campaign.mcap was not written",
@@ -284,24 +271,11 @@ pub(super) fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
         eprintln!(
             "merged {} shards ({} runs) → {}",
             dirs.len(),
-            rows.len(),
+            rows,
             out.display()
         );
     }
     0
-}
-
-/// Memory a campaign holds per run at its peak, when the table, its CSV text and its Parquet
-/// bytes coexist (measured: about 1.8 kB with the test campaign's 32 columns;
-/// docs/montecarlo.md).
-const TABLE_BYTES_PER_RUN: f64 = 2000.0;
-
-/// `MemAvailable` of /proc/meminfo (MiB), where there is one.
-fn available_memory_mib() -> Option<f64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
 }
 
 /// Peak resident memory of this process (MiB), from Linux's `/proc/self/status` (`VmHWM`).

@@ -4,10 +4,13 @@
 //! Run i draws from the ChaCha8 stream (seed, i): its draws depend on nothing else, so a
 //! campaign gives the same table whatever the thread count, the order of the runs or the way
 //! it is split into shards. Runs are independent and single-threaded; rayon spreads them over
-//! the cores. Only the per-run table is kept in memory.
+//! the cores, a block of runs at a time, and the finished rows go to the writers in run order:
+//! a campaign's memory does not grow with its number of runs.
 
 mod dispersion;
 pub mod output;
+pub mod runs;
+mod select;
 mod spec;
 mod summary;
 pub mod table;
@@ -30,6 +33,11 @@ use sha2::{Digest, Sha256};
 use std::ops::Range;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Runs a campaign runs in parallel before their rows are written: the most rows it holds.
+/// Each block ends when its slowest run does, which costs at most about one run's time per
+/// thread and block.
+pub const BLOCK_RUNS: u64 = 4096;
 
 /// A campaign ready to run: the nominal scenario, its tree, the checked campaign and the
 /// table's columns.
@@ -451,25 +459,75 @@ impl Prepared {
         interrupt: &AtomicBool,
         on_row: &(dyn Fn(&Row) + Sync),
     ) -> Result<(Vec<Row>, bool), String> {
+        let mut rows = Vec::new();
+        let partial = self.execute_streaming(range, threads, interrupt, on_row, &mut |r| {
+            rows.push(r);
+            Ok(())
+        })?;
+        Ok((rows, partial))
+    }
+
+    /// Runs `range` on `threads` threads, [`BLOCK_RUNS`] runs at a time, and hands the
+    /// finished runs to `consume` in run order; holds one block's rows at most. Calls
+    /// `on_row` as each run finishes (from any thread). Returns whether any run was skipped
+    /// or cut short by `interrupt`; an error of `consume` ends the campaign.
+    pub fn execute_streaming(
+        &self,
+        range: Range<u64>,
+        threads: usize,
+        interrupt: &AtomicBool,
+        on_row: &(dyn Fn(&Row) + Sync),
+        consume: &mut dyn FnMut(Row) -> Result<(), String>,
+    ) -> Result<bool, String> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads.max(1))
             .build()
             .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
-        let results: Vec<Option<Row>> = pool.install(|| {
-            range
-                .into_par_iter()
-                .map(|i| {
-                    if interrupt.load(Ordering::Relaxed) {
-                        return None;
-                    }
-                    let row = self.run_one(i, interrupt)?;
-                    on_row(&row);
-                    Some(row)
+        let mut partial = false;
+        let mut start = range.start;
+        while start < range.end {
+            let block = start..(start + BLOCK_RUNS).min(range.end);
+            start = block.end;
+            let results: Vec<Option<Row>> = pool.install(|| {
+                block
+                    .into_par_iter()
+                    .map(|i| {
+                        if interrupt.load(Ordering::Relaxed) {
+                            return None;
+                        }
+                        let row = self.run_one(i, interrupt)?;
+                        on_row(&row);
+                        Some(row)
+                    })
+                    .collect()
+            });
+            for r in results {
+                match r {
+                    Some(r) => consume(r)?,
+                    None => partial = true,
+                }
+            }
+        }
+        Ok(partial)
+    }
+
+    /// What the campaign's summary is computed from, besides the runs.
+    pub fn summary_spec(&self) -> summary::SummarySpec {
+        summary::SummarySpec {
+            columns: self.columns.clone(),
+            events: self
+                .event_conditions
+                .iter()
+                .enumerate()
+                .map(|(k, c)| summary::EventColumn {
+                    condition: c.clone(),
+                    name: self.columns[self.event_start + k].clone(),
+                    column: self.event_start + k,
                 })
-                .collect()
-        });
-        let partial = results.iter().any(Option::is_none);
-        Ok((results.into_iter().flatten().collect(), partial))
+                .collect(),
+            probability_by: self.campaign.probability_by.clone(),
+            rank: self.rank_rule(),
+        }
     }
 
     /// How runs are ranked: by the flat-spin event time (earliest is worst) or, without

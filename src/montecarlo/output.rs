@@ -7,8 +7,9 @@
 //! `campaign.mcap`. `campaign.json`, the manifest, is written last: a directory without it
 //! holds no finished result. Every file is written under a temporary name and renamed.
 
-use super::summary::{self, ColumnStats, EventStats, Failure, Ranking, StatusCounts};
-use super::table::{self, Row};
+use super::runs::{RunStore, Runs};
+use super::summary::{self, ColumnStats, EventStats, Failure, Ranking, StatusCounts, Tally};
+use super::table::{self, CsvWriter, ParquetWriter, Row};
 use super::{Prepared, sha256_hex, shard_range};
 use crate::log::{Attachment, McapLogger, write_atomically};
 use crate::plot::{Chart, Series, Style};
@@ -17,6 +18,8 @@ use crate::sim::{self, Control};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -137,11 +140,11 @@ pub struct Manifest {
 
 /// `summary.json`.
 #[derive(Debug, Serialize)]
-struct SummaryDoc<'a> {
+struct SummaryDoc {
     format: &'static str,
-    polhode_version: &'a str,
-    scenario: &'a str,
-    scenario_sha256: &'a str,
+    polhode_version: String,
+    scenario: String,
+    scenario_sha256: String,
     seed: u64,
     runs: u64,
     shard: Option<[u64; 2]>,
@@ -157,10 +160,201 @@ struct SummaryDoc<'a> {
     failures: Vec<Failure>,
 }
 
-/// Writes every output of `rows` (the runs of the range that finished) into `dir`, after
-/// removing a previous campaign's. A whole campaign (`shard` None) also gets the charts and,
-/// unless it is partial, the MCAP of its worst, median and best runs, which are re-run: if
-/// `interrupt` is set meanwhile, the MCAP is left out and everything else is still written.
+/// Writes a campaign's outputs into a directory as its runs finish, in run order: the CSV
+/// and Parquet tables row by row (under temporary names), the runs' values to a scratch file
+/// for the summary's later passes, and the one-look statistics ([`Tally`]). Its memory does
+/// not grow with the number of runs. [`CampaignWriter::finish`] writes the rest; dropped
+/// before that, it leaves nothing behind.
+pub struct CampaignWriter<'a> {
+    dir: PathBuf,
+    prep: &'a Prepared,
+    shard: Option<[u64; 2]>,
+    /// The open writers (taken by `finish`).
+    open: Option<OpenTables>,
+    tally: Tally,
+    /// Temporary and final names of the tables, removed on drop until renamed.
+    temporary: Vec<(PathBuf, PathBuf)>,
+}
+
+/// The writers of a [`CampaignWriter`] while runs are pushed.
+struct OpenTables {
+    csv: CsvWriter<BufWriter<File>>,
+    parquet: ParquetWriter<BufWriter<File>>,
+    store: RunStore,
+}
+
+/// A temporary name in `dir` for the file `name`.
+fn temporary_name(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+impl<'a> CampaignWriter<'a> {
+    /// Removes a previous campaign's outputs from `dir` (created if needed) and starts
+    /// writing this one's (`shard`: which shard, or `None` for a whole campaign).
+    pub fn create(dir: &Path, prep: &'a Prepared, shard: Option<[u64; 2]>) -> Result<Self, String> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        clear_outputs(dir)?;
+        let open = |name: &str| -> Result<(BufWriter<File>, (PathBuf, PathBuf)), String> {
+            let target = dir.join(name);
+            crate::log::check_replaceable(&target)
+                .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
+            let tmp = temporary_name(dir, name);
+            let f = File::create(&tmp)
+                .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
+            Ok((BufWriter::with_capacity(1 << 20, f), (tmp, target)))
+        };
+        let (csv_file, csv_names) = open("runs.csv")?;
+        let (parquet_file, parquet_names) = match open("runs.parquet") {
+            Ok(x) => x,
+            Err(e) => {
+                let _ = std::fs::remove_file(&csv_names.0);
+                return Err(e);
+            }
+        };
+        let mut temporary = vec![csv_names, parquet_names];
+        let result = (|| {
+            let io = |e: std::io::Error| format!("cannot write runs.csv: {e}");
+            let csv = CsvWriter::new(csv_file, &prep.columns).map_err(io)?;
+            let parquet = ParquetWriter::new(parquet_file, &prep.columns)
+                .map_err(|e| format!("cannot write runs.parquet: {e}"))?;
+            let store = RunStore::create(&temporary_name(dir, "runs.scratch"), prep.columns.len())?;
+            Ok::<_, String>((csv, parquet, store))
+        })();
+        let (csv, parquet, store) = match result {
+            Ok(x) => x,
+            Err(e) => {
+                for (tmp, _) in temporary.drain(..) {
+                    let _ = std::fs::remove_file(tmp);
+                }
+                return Err(e);
+            }
+        };
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            prep,
+            shard,
+            open: Some(OpenTables {
+                csv,
+                parquet,
+                store,
+            }),
+            tally: Tally::new(prep.summary_spec()),
+            temporary,
+        })
+    }
+
+    /// Appends a finished run (runs come in run order).
+    pub fn push(&mut self, row: Row) -> Result<(), String> {
+        let Some(open) = self.open.as_mut() else {
+            return Err("the campaign's tables are already closed".into());
+        };
+        open.csv
+            .push(&row)
+            .map_err(|e| format!("cannot write {}: {e}", self.dir.join("runs.csv").display()))?;
+        open.store.push(&row)?;
+        self.tally.add(&row);
+        open.parquet.push(row).map_err(|e| {
+            format!(
+                "cannot write {}: {e}",
+                self.dir.join("runs.parquet").display()
+            )
+        })
+    }
+
+    /// Runs pushed so far.
+    pub fn rows(&self) -> u64 {
+        self.tally.runs() as u64
+    }
+
+    /// Moves the tables into place and writes the rest: the scenario, the summaries and, for
+    /// a whole campaign, the charts and (unless `partial`) the MCAP of its worst, median and
+    /// best runs, which are re-run: if `interrupt` is set meanwhile, the MCAP is left out and
+    /// everything else is still written. The manifest comes last.
+    pub fn finish(mut self, partial: bool, interrupt: &AtomicBool) -> Result<Written, String> {
+        let dir = self.dir.clone();
+        let mut written = Vec::new();
+        let fail = |name: &str, e: &dyn std::fmt::Display| {
+            format!("cannot write {}: {e}", dir.join(name).display())
+        };
+        let OpenTables {
+            csv,
+            parquet,
+            store,
+        } = self
+            .open
+            .take()
+            .ok_or("the campaign's tables are already closed")?;
+        let (file, sha) = csv.finish().map_err(|e| fail("runs.csv", &e))?;
+        sync(file).map_err(|e| fail("runs.csv", &e))?;
+        let file = parquet.finish().map_err(|e| fail("runs.parquet", &e))?;
+        sync(file).map_err(|e| fail("runs.parquet", &e))?;
+        for (tmp, target) in std::mem::take(&mut self.temporary) {
+            let name = target.display().to_string();
+            if let Err(e) = std::fs::rename(&tmp, &target) {
+                let _ = std::fs::remove_file(&tmp);
+                return Err(format!("cannot write {name}: {e}"));
+            }
+            written.push(target);
+        }
+        let put = |written: &mut Vec<PathBuf>, name: &str, bytes: &[u8]| -> Result<(), String> {
+            let p = dir.join(name);
+            write_atomically(&p, bytes)
+                .map_err(|e| format!("cannot write {}: {e}", p.display()))?;
+            written.push(p);
+            Ok(())
+        };
+        let prep = self.prep;
+        put(
+            &mut written,
+            "scenario.yaml",
+            prep.scenario.source.as_bytes(),
+        )?;
+        let runs = store.finish()?;
+        let manifest = manifest(prep, self.rows(), self.shard, partial, sha);
+        let stats = summary::statistics(&self.tally, &runs)?;
+        let plan = chart_plan(prep, &self.tally, self.shard);
+        let doc = summary_doc(&manifest, stats, plan);
+        let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
+        put(&mut written, "summary.json", json.as_bytes())?;
+        put(&mut written, "summary.txt", summary_text(&doc).as_bytes())?;
+        let mut mcap_interrupted = false;
+        if self.shard.is_none() {
+            written.extend(charts(&dir, prep, &runs, &doc)?);
+            if let Some(r) = &doc.ranking
+                && !partial
+            {
+                match trajectories(&dir, prep, r, &json, interrupt)? {
+                    Some(p) => written.push(p),
+                    None => mcap_interrupted = true,
+                }
+            }
+        }
+        drop(runs);
+        let m = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
+        put(&mut written, "campaign.json", m.as_bytes())?;
+        Ok(Written {
+            files: written,
+            mcap_interrupted,
+        })
+    }
+}
+
+impl Drop for CampaignWriter<'_> {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.temporary {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Flushes a table's file to disk.
+fn sync(file: BufWriter<File>) -> std::io::Result<()> {
+    file.into_inner().map_err(|e| e.into_error())?.sync_all()
+}
+
+/// Writes every output of `rows` (the runs of the range that finished, in run order) into
+/// `dir`, as [`CampaignWriter`] does.
 pub fn write_outputs(
     dir: &Path,
     prep: &Prepared,
@@ -169,64 +363,20 @@ pub fn write_outputs(
     partial: bool,
     interrupt: &AtomicBool,
 ) -> Result<Written, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    clear_outputs(dir)?;
-    let mut written = Vec::new();
-    let put = |written: &mut Vec<PathBuf>, name: &str, bytes: &[u8]| -> Result<(), String> {
-        let p = dir.join(name);
-        write_atomically(&p, bytes).map_err(|e| format!("cannot write {}: {e}", p.display()))?;
-        written.push(p);
-        Ok(())
-    };
-    let csv = table::to_csv(&prep.columns, rows);
-    put(&mut written, "runs.csv", csv.as_bytes())?;
-    put(
-        &mut written,
-        "runs.parquet",
-        &table::to_parquet(&prep.columns, rows)?,
-    )?;
-    put(
-        &mut written,
-        "scenario.yaml",
-        prep.scenario.source.as_bytes(),
-    )?;
-    let manifest = manifest(prep, rows, shard, partial, &csv);
-    let plan = chart_plan(prep, rows, shard);
-    let doc = summary_doc(prep, rows, &manifest, plan);
-    let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
-    put(&mut written, "summary.json", json.as_bytes())?;
-    put(
-        &mut written,
-        "summary.txt",
-        summary_text(prep, &doc).as_bytes(),
-    )?;
-    let mut mcap_interrupted = false;
-    if shard.is_none() {
-        written.extend(charts(dir, prep, rows, &doc.charts)?);
-        if let Some(r) = &doc.ranking
-            && !partial
-        {
-            match trajectories(dir, prep, r, &json, interrupt)? {
-                Some(p) => written.push(p),
-                None => mcap_interrupted = true,
-            }
-        }
+    let mut w = CampaignWriter::create(dir, prep, shard)?;
+    for r in rows {
+        w.push(r.clone())?;
     }
-    let m = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
-    put(&mut written, "campaign.json", m.as_bytes())?;
-    Ok(Written {
-        files: written,
-        mcap_interrupted,
-    })
+    w.finish(partial, interrupt)
 }
 
-/// The manifest of `rows` (`csv`: their `runs.csv` text).
+/// The manifest of a table of `rows` runs whose `runs.csv` has the hex SHA-256 `csv_sha256`.
 fn manifest(
     prep: &Prepared,
-    rows: &[Row],
+    rows: u64,
     shard: Option<[u64; 2]>,
     partial: bool,
-    csv: &str,
+    csv_sha256: String,
 ) -> Manifest {
     let range = match shard {
         Some([k, n]) => shard_range(prep.campaign.runs, k, n),
@@ -242,10 +392,10 @@ fn manifest(
         runs: prep.campaign.runs,
         shard,
         run_range: [range.start, range.end],
-        runs_in_table: rows.len() as u64,
+        runs_in_table: rows,
         partial,
         columns: prep.columns.clone(),
-        runs_csv_sha256: sha256_hex(csv.as_bytes()),
+        runs_csv_sha256: csv_sha256,
         method: prep.method.clone(),
     }
 }
@@ -259,56 +409,38 @@ pub fn summary_json(
     shard: Option<[u64; 2]>,
     partial: bool,
 ) -> Result<String, String> {
-    let csv = table::to_csv(&prep.columns, rows);
-    let manifest = manifest(prep, rows, shard, partial, &csv);
-    let plan = chart_plan(prep, rows, shard);
-    let doc = summary_doc(prep, rows, &manifest, plan);
+    let mut tally = Tally::new(prep.summary_spec());
+    rows.iter().for_each(|r| tally.add(r));
+    let manifest = manifest(prep, rows.len() as u64, shard, partial, String::new());
+    let stats = summary::statistics(&tally, &rows)?;
+    let plan = chart_plan(prep, &tally, shard);
+    let doc = summary_doc(&manifest, stats, plan);
     Ok(serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n")
 }
 
-fn summary_doc<'a>(
-    prep: &'a Prepared,
-    rows: &[Row],
-    m: &'a Manifest,
-    charts: Vec<EventCharts>,
-) -> SummaryDoc<'a> {
-    let events = prep
-        .event_conditions
-        .iter()
-        .enumerate()
-        .map(|(k, c)| {
-            let j = prep.event_start + k;
-            summary::event_stats(c, &prep.columns[j], j, rows, &prep.campaign.probability_by)
-        })
-        .collect();
-    let columns = prep
-        .columns
-        .iter()
-        .enumerate()
-        .filter_map(|(j, c)| summary::column_stats(c, j, rows))
-        .collect();
+fn summary_doc(m: &Manifest, stats: summary::Statistics, charts: Vec<EventCharts>) -> SummaryDoc {
     SummaryDoc {
         format: "polhode-campaign-summary/1",
-        polhode_version: &m.polhode_version,
-        scenario: &m.scenario,
-        scenario_sha256: &m.scenario_sha256,
+        polhode_version: m.polhode_version.clone(),
+        scenario: m.scenario.clone(),
+        scenario_sha256: m.scenario_sha256.clone(),
         seed: m.seed,
         runs: m.runs,
         shard: m.shard,
         run_range: m.run_range,
         runs_in_table: m.runs_in_table,
         partial: m.partial,
-        status: summary::status_counts(rows),
+        status: stats.status,
         percentiles: &summary::PERCENTILES,
-        events,
+        events: stats.events,
         charts,
-        ranking: summary::rank(rows, &prep.rank_rule()),
-        columns,
-        failures: summary::failures(rows),
+        ranking: stats.ranking,
+        columns: stats.columns,
+        failures: stats.failures,
     }
 }
 
-fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
+fn summary_text(d: &SummaryDoc) -> String {
     let mut out = String::new();
     let f = summary::fmt;
     let _ = writeln!(
@@ -402,7 +534,6 @@ fn summary_text(prep: &Prepared, d: &SummaryDoc) -> String {
             let _ = writeln!(out, "  run {} ({}): {}", x.run, x.status, x.message);
         }
     }
-    let _ = prep;
     out
 }
 
@@ -448,52 +579,61 @@ const FLAT_SPIN_CHARTS: [&str; 3] = [
 
 /// The charts a whole campaign draws: three for each event that some usable run reached, in
 /// the order of the events. None for a shard (the merge draws them).
-fn chart_plan(prep: &Prepared, rows: &[Row], shard: Option<[u64; 2]>) -> Vec<EventCharts> {
+fn chart_plan(prep: &Prepared, tally: &Tally, shard: Option<[u64; 2]>) -> Vec<EventCharts> {
     if shard.is_some() {
         return Vec::new();
     }
     prep.event_conditions
         .iter()
         .enumerate()
-        .filter_map(|(k, condition)| {
+        .filter(|(k, _)| tally.event_reached(*k))
+        .map(|(k, condition)| {
             let j = prep.event_start + k;
-            rows.iter()
-                .any(|r| r.status.ok() && r.values[j].is_some())
-                .then(|| {
-                    let column = prep.columns[j].clone();
-                    let charts: Vec<String> = EVENT_CHART_SUFFIXES
-                        .iter()
-                        .map(|s| format!("{column}{s}"))
-                        .collect();
-                    let flat_spin = if prep.primary_event == Some(j) {
-                        FLAT_SPIN_CHARTS.map(String::from).to_vec()
-                    } else {
-                        Vec::new()
-                    };
-                    EventCharts {
-                        condition: condition.clone(),
-                        column,
-                        j,
-                        files: svg_png(&charts),
-                        flat_spin_files: svg_png(&flat_spin),
-                        charts,
-                        flat_spin,
-                    }
-                })
+            let column = prep.columns[j].clone();
+            let charts: Vec<String> = EVENT_CHART_SUFFIXES
+                .iter()
+                .map(|s| format!("{column}{s}"))
+                .collect();
+            let flat_spin = if prep.primary_event == Some(j) {
+                FLAT_SPIN_CHARTS.map(String::from).to_vec()
+            } else {
+                Vec::new()
+            };
+            EventCharts {
+                condition: condition.clone(),
+                column,
+                j,
+                files: svg_png(&charts),
+                flat_spin_files: svg_png(&flat_spin),
+                charts,
+                flat_spin,
+            }
         })
         .collect()
 }
 
-/// Draws every event's charts as planned by [`chart_plan`].
+/// Draws every event's charts as planned in `doc`.
 fn charts(
     dir: &Path,
     prep: &Prepared,
-    rows: &[Row],
-    plan: &[EventCharts],
+    runs: &dyn Runs,
+    doc: &SummaryDoc,
 ) -> Result<Vec<PathBuf>, String> {
+    let mut data: Vec<EventChartData> = doc
+        .charts
+        .iter()
+        .filter_map(|p| EventChartData::new(doc, p))
+        .collect();
+    runs.scan(&mut |r| {
+        if r.ok {
+            for d in &mut data {
+                d.add(r.values[prep.transverse_column], r.values[d.j]);
+            }
+        }
+    })?;
     let mut out = Vec::new();
-    for p in plan {
-        let drawn = event_charts(prep, rows, p.j, !p.flat_spin.is_empty());
+    for (p, d) in doc.charts.iter().zip(&data) {
+        let drawn = d.charts(prep, !p.flat_spin.is_empty());
         for (k, chart) in drawn.iter().enumerate() {
             let mut stems = vec![dir.join(&p.charts[k])];
             if let Some(name) = p.flat_spin.get(k) {
@@ -509,98 +649,192 @@ fn charts(
     Ok(out)
 }
 
-/// Histogram and CDF of the time of the event of column `j`, and initial transverse rate
-/// against it (titled as the flat spin when `flat_spin`). Empty when no usable run reached it.
-fn event_charts(prep: &Prepared, rows: &[Row], j: usize, flat_spin: bool) -> Vec<Chart> {
-    let usable: Vec<&Row> = rows.iter().filter(|r| r.status.ok()).collect();
-    let mut times: Vec<f64> = usable.iter().filter_map(|r| r.values[j]).collect();
-    if times.is_empty() {
-        return vec![];
-    }
-    times.sort_by(f64::total_cmp);
-    let condition = &prep.event_conditions[j - prep.event_start];
-    let n = usable.len();
-    let reached = times.len();
-    let minutes = |t: f64| t / 60.0;
-    let mut out = Vec::new();
+/// Up to this many event times are drawn as the CDF's exact staircase; beyond, the CDF is
+/// drawn through [`CDF_BINS`] bins.
+const CDF_EXACT_POINTS: usize = 4096;
+/// Bins of a CDF drawn from more than [`CDF_EXACT_POINTS`] times.
+const CDF_BINS: usize = 1024;
+/// The scatter chart shows at most twice this many runs: past that, every other run shown
+/// is dropped, and so on (every 2ᵏ-th run, in run order).
+const SCATTER_POINTS: usize = 4096;
 
-    // Histogram: bins by the Freedman–Diaconis rule, 10 to 60 of them.
-    let (lo, hi) = (times[0], times[reached - 1]);
-    let iqr = summary::percentile(&times, 75.0) - summary::percentile(&times, 25.0);
-    let width = 2.0 * iqr / (reached as f64).cbrt();
-    let bins = if width > 0.0 && hi > lo {
-        (((hi - lo) / width).ceil() as usize).clamp(10, 60)
-    } else {
-        10
-    };
-    let span = if hi > lo { hi - lo } else { 1.0 };
-    let mut counts = vec![0usize; bins];
-    for t in &times {
-        let b = (((t - lo) / span) * bins as f64).floor() as usize;
-        counts[b.min(bins - 1)] += 1;
-    }
-    let mut outline = vec![(minutes(lo), 0.0)];
-    for (b, c) in counts.iter().enumerate() {
-        let x0 = minutes(lo + span * b as f64 / bins as f64);
-        let x1 = minutes(lo + span * (b + 1) as f64 / bins as f64);
-        outline.push((x0, *c as f64));
-        outline.push((x1, *c as f64));
-    }
-    outline.push((minutes(lo + span), 0.0));
-    let title = if flat_spin {
-        format!("Time to flat spin ({condition}): {reached} of {n} runs")
-    } else {
-        format!("Time to `{condition}`: {reached} of {n} runs")
-    };
-    let mut h = Chart::new(title, "time (min)", "runs per bin");
-    h.x_range = Some((minutes(lo - 0.05 * span), minutes(hi + 0.05 * span)));
-    let tallest = counts.iter().copied().max().unwrap_or(1) as f64;
-    h.y_range = Some((0.0, 1.1 * tallest));
-    h.series.push(Series::new("", outline, Style::Line));
-    out.push(h);
+/// What one event's charts are drawn from, gathered in one pass over the runs in a memory
+/// that does not grow with their number.
+struct EventChartData {
+    /// Event column.
+    j: usize,
+    /// Usable runs, and those in which the event happened.
+    usable: usize,
+    reached: usize,
+    /// Earliest and latest event time (s).
+    lo: f64,
+    hi: f64,
+    /// Histogram counts over [lo, hi].
+    counts: Vec<usize>,
+    /// Every event time, sorted once gathered (for at most [`CDF_EXACT_POINTS`] times), or
+    /// the CDF's bin counts over [lo, hi].
+    times: Vec<f64>,
+    cdf_counts: Vec<usize>,
+    /// Scatter points (initial transverse rate, time in minutes), every `stride`-th run with
+    /// both values; `seen` counts those runs.
+    points: Vec<(f64, f64)>,
+    stride: usize,
+    seen: usize,
+}
 
-    // CDF over all usable runs: it ends below 1 when some runs never reach the event.
-    // From t = 0 to the end of the scenario, so both ends of the staircase are visible.
-    let mut cdf = vec![(0.0, 0.0)];
-    for (k, t) in times.iter().enumerate() {
-        cdf.push((minutes(*t), k as f64 / n as f64));
-        cdf.push((minutes(*t), (k + 1) as f64 / n as f64));
+impl EventChartData {
+    /// The data of planned chart `p`, with the extremes and quartiles from the summary.
+    fn new(doc: &SummaryDoc, p: &EventCharts) -> Option<Self> {
+        let e = doc.events.iter().find(|e| e.column == p.column)?;
+        let c = doc.columns.iter().find(|c| c.column == p.column)?;
+        // Histogram: bins by the Freedman–Diaconis rule, 10 to 60 of them.
+        let (lo, hi) = (c.min, c.max);
+        let iqr = c.percentiles[4] - c.percentiles[2];
+        debug_assert_eq!(
+            (summary::PERCENTILES[2], summary::PERCENTILES[4]),
+            (25.0, 75.0)
+        );
+        let width = 2.0 * iqr / (c.count as f64).cbrt();
+        let bins = if width > 0.0 && hi > lo {
+            (((hi - lo) / width).ceil() as usize).clamp(10, 60)
+        } else {
+            10
+        };
+        let exact = e.reached <= CDF_EXACT_POINTS;
+        Some(Self {
+            j: p.j,
+            usable: e.runs,
+            reached: e.reached,
+            lo,
+            hi,
+            counts: vec![0; bins],
+            times: Vec::new(),
+            cdf_counts: if exact { Vec::new() } else { vec![0; CDF_BINS] },
+            points: Vec::new(),
+            stride: 1,
+            seen: 0,
+        })
     }
-    cdf.push((
-        minutes(prep.scenario.duration.max(hi)),
-        reached as f64 / n as f64,
-    ));
-    let title = if flat_spin {
-        format!("Probability of a flat spin ({condition}) by time")
-    } else {
-        format!("Probability of `{condition}` by time")
-    };
-    let mut c = Chart::new(title, "time (min)", "fraction of runs");
-    c.y_range = Some((0.0, 1.05));
-    c.series.push(Series::new("", cdf, Style::Line));
-    out.push(c);
 
-    // Scatter.
-    let points: Vec<(f64, f64)> = usable
-        .iter()
-        .filter_map(|r| Some((r.values[prep.transverse_column]?, minutes(r.values[j]?))))
-        .collect();
-    let mut s = if flat_spin {
-        Chart::new(
-            "Initial transverse rate against time to flat spin",
-            "initial transverse rate (rad/s)",
-            "time to flat spin (min)",
-        )
-    } else {
-        Chart::new(
-            format!("Initial transverse rate against time to `{condition}`"),
-            "initial transverse rate (rad/s)",
-            "time of the event (min)",
-        )
-    };
-    s.series.push(Series::new("", points, Style::Markers));
-    out.push(s);
-    out
+    /// The bin of `t` among `bins` over [lo, hi].
+    fn bin(&self, t: f64, bins: usize) -> usize {
+        let span = if self.hi > self.lo {
+            self.hi - self.lo
+        } else {
+            1.0
+        };
+        ((((t - self.lo) / span) * bins as f64).floor() as usize).min(bins - 1)
+    }
+
+    /// Counts a usable run with initial transverse rate `rate` and event time `t`.
+    fn add(&mut self, rate: Option<f64>, t: Option<f64>) {
+        let Some(t) = t else { return };
+        let b = self.bin(t, self.counts.len());
+        self.counts[b] += 1;
+        if self.cdf_counts.is_empty() {
+            self.times.push(t);
+        } else {
+            let b = self.bin(t, CDF_BINS);
+            self.cdf_counts[b] += 1;
+        }
+        if let Some(rate) = rate {
+            if self.seen.is_multiple_of(self.stride) {
+                self.points.push((rate, t / 60.0));
+                if self.points.len() == 2 * SCATTER_POINTS {
+                    self.points = self.points.iter().copied().step_by(2).collect();
+                    self.stride *= 2;
+                }
+            }
+            self.seen += 1;
+        }
+    }
+
+    /// Histogram and CDF of the event time, and initial transverse rate against it (titled
+    /// as the flat spin when `flat_spin`).
+    fn charts(&self, prep: &Prepared, flat_spin: bool) -> Vec<Chart> {
+        let condition = &prep.event_conditions[self.j - prep.event_start];
+        let (n, reached, lo, hi) = (self.usable, self.reached, self.lo, self.hi);
+        let minutes = |t: f64| t / 60.0;
+        let mut out = Vec::new();
+
+        let bins = self.counts.len();
+        let span = if hi > lo { hi - lo } else { 1.0 };
+        let mut outline = vec![(minutes(lo), 0.0)];
+        for (b, c) in self.counts.iter().enumerate() {
+            let x0 = minutes(lo + span * b as f64 / bins as f64);
+            let x1 = minutes(lo + span * (b + 1) as f64 / bins as f64);
+            outline.push((x0, *c as f64));
+            outline.push((x1, *c as f64));
+        }
+        outline.push((minutes(lo + span), 0.0));
+        let title = if flat_spin {
+            format!("Time to flat spin ({condition}): {reached} of {n} runs")
+        } else {
+            format!("Time to `{condition}`: {reached} of {n} runs")
+        };
+        let mut h = Chart::new(title, "time (min)", "runs per bin");
+        h.x_range = Some((minutes(lo - 0.05 * span), minutes(hi + 0.05 * span)));
+        let tallest = self.counts.iter().copied().max().unwrap_or(1) as f64;
+        h.y_range = Some((0.0, 1.1 * tallest));
+        h.series.push(Series::new("", outline, Style::Line));
+        out.push(h);
+
+        // CDF over all usable runs: it ends below 1 when some runs never reach the event.
+        // From t = 0 to the end of the scenario, so both ends of the staircase are visible.
+        let mut cdf = vec![(0.0, 0.0)];
+        if self.cdf_counts.is_empty() {
+            let mut times = self.times.clone();
+            times.sort_by(f64::total_cmp);
+            for (k, t) in times.iter().enumerate() {
+                cdf.push((minutes(*t), k as f64 / n as f64));
+                cdf.push((minutes(*t), (k + 1) as f64 / n as f64));
+            }
+        } else {
+            cdf.push((minutes(lo), 0.0));
+            let mut below = 0;
+            for (b, c) in self.cdf_counts.iter().enumerate() {
+                below += c;
+                let edge = lo + span * (b + 1) as f64 / CDF_BINS as f64;
+                cdf.push((minutes(edge), below as f64 / n as f64));
+            }
+        }
+        cdf.push((
+            minutes(prep.scenario.duration.max(hi)),
+            reached as f64 / n as f64,
+        ));
+        let title = if flat_spin {
+            format!("Probability of a flat spin ({condition}) by time")
+        } else {
+            format!("Probability of `{condition}` by time")
+        };
+        let mut c = Chart::new(title, "time (min)", "fraction of runs");
+        c.y_range = Some((0.0, 1.05));
+        c.series.push(Series::new("", cdf, Style::Line));
+        out.push(c);
+
+        let shown = if self.stride > 1 {
+            format!(" (1 in {} of {} runs shown)", self.stride, self.seen)
+        } else {
+            String::new()
+        };
+        let mut s = if flat_spin {
+            Chart::new(
+                format!("Initial transverse rate against time to flat spin{shown}"),
+                "initial transverse rate (rad/s)",
+                "time to flat spin (min)",
+            )
+        } else {
+            Chart::new(
+                format!("Initial transverse rate against time to `{condition}`{shown}"),
+                "initial transverse rate (rad/s)",
+                "time of the event (min)",
+            )
+        };
+        s.series
+            .push(Series::new("", self.points.clone(), Style::Markers));
+        out.push(s);
+        out
+    }
 }
 
 /// `campaign.mcap`: the worst, median and best runs re-run with full logging under
@@ -686,8 +920,23 @@ fn trajectories(
 struct ShardOutput {
     dir: PathBuf,
     manifest: Manifest,
-    csv: String,
     scenario: String,
+}
+
+/// Hex SHA-256 of the file `path`, read a block at a time.
+fn file_sha256(path: &Path) -> std::io::Result<String> {
+    use sha2::{Digest, Sha256};
+    let mut input = BufReader::with_capacity(1 << 20, File::open(path)?);
+    let mut hash = Sha256::new();
+    let mut block = vec![0u8; 1 << 20];
+    loop {
+        let n = input.read(&mut block)?;
+        if n == 0 {
+            break;
+        }
+        hash.update(&block[..n]);
+    }
+    Ok(hash.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
 fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
@@ -717,9 +966,9 @@ fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
             manifest.runs
         ));
     }
-    let csv =
-        std::fs::read_to_string(dir.join("runs.csv")).map_err(|e| format!("{d}/runs.csv: {e}"))?;
-    if sha256_hex(csv.as_bytes()) != manifest.runs_csv_sha256 {
+    let csv_sha256 =
+        file_sha256(&dir.join("runs.csv")).map_err(|e| format!("{d}/runs.csv: {e}"))?;
+    if csv_sha256 != manifest.runs_csv_sha256 {
         return Err(format!(
             "{d}/runs.csv does not match its manifest (truncated or altered after it was \
              written); re-run this shard"
@@ -735,14 +984,19 @@ fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
     Ok(ShardOutput {
         dir: dir.to_path_buf(),
         manifest,
-        csv,
         scenario,
     })
 }
 
 /// Checks that `dirs` hold every shard of one campaign exactly once, unaltered and finished,
-/// and returns the campaign and its rows in run order.
-pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
+/// and writes the whole campaign's outputs into `out` (see [`CampaignWriter::finish`] for
+/// `interrupt`). Reads the shards' tables twice, a row at a time: to check every row before
+/// anything is written, then to write them. Returns what was written and the number of runs.
+pub fn merge(
+    dirs: &[PathBuf],
+    out: &Path,
+    interrupt: &AtomicBool,
+) -> Result<(Written, u64), String> {
     if dirs.is_empty() {
         return Err("expected the shard directories to merge".into());
     }
@@ -856,22 +1110,47 @@ pub fn merge(dirs: &[PathBuf]) -> Result<(Prepared, Vec<Row>), String> {
     if prep.columns != m0.columns {
         return Err("the shards were written with other table columns".into());
     }
-    let mut rows = Vec::with_capacity(m0.runs as usize);
-    for (k, s) in &by_index {
-        let part = table::from_csv(&s.csv, &prep.columns)
-            .map_err(|e| format!("{}/runs.csv: {e}", s.dir.display()))?;
-        let range = shard_range(m0.runs, *k, n);
-        let expected: Vec<u64> = range.clone().collect();
-        let got: Vec<u64> = part.iter().map(|r| r.run).collect();
-        if got != expected || s.manifest.run_range != [range.start, range.end] {
-            return Err(format!(
-                "{}/runs.csv does not hold exactly runs {} to {} of shard {k}",
-                s.dir.display(),
-                range.start,
-                range.end.saturating_sub(1)
-            ));
+    // Every shard's rows: exactly its range's runs, in order.
+    let read = |each: &mut dyn FnMut(Row) -> Result<(), String>| -> Result<(), String> {
+        for (k, s) in &by_index {
+            let d = s.dir.display();
+            let range = shard_range(m0.runs, *k, n);
+            let wrong = || {
+                format!(
+                    "{d}/runs.csv does not hold exactly runs {} to {} of shard {k}",
+                    range.start,
+                    range.end.saturating_sub(1)
+                )
+            };
+            if s.manifest.run_range != [range.start, range.end] {
+                return Err(wrong());
+            }
+            let file =
+                File::open(s.dir.join("runs.csv")).map_err(|e| format!("{d}/runs.csv: {e}"))?;
+            let mut next = range.start;
+            table::read_csv(BufReader::new(file), &prep.columns, |row| {
+                if row.run != next || next >= range.end {
+                    return Err(wrong());
+                }
+                next += 1;
+                each(row)
+            })
+            .map_err(|e| {
+                if e.contains("does not hold") {
+                    e
+                } else {
+                    format!("{d}/runs.csv: {e}")
+                }
+            })?;
+            if next != range.end {
+                return Err(wrong());
+            }
         }
-        rows.extend(part);
-    }
-    Ok((prep, rows))
+        Ok(())
+    };
+    read(&mut |_| Ok(()))?;
+    let mut writer = CampaignWriter::create(out, &prep, None)?;
+    read(&mut |row| writer.push(row))?;
+    let runs = writer.rows();
+    Ok((writer.finish(false, interrupt)?, runs))
 }

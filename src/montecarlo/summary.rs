@@ -1,6 +1,10 @@
 //! Campaign statistics computed from the per-run table alone, so that a merged set of shards
-//! and a single-process campaign give the same summary.
+//! and a single-process campaign give the same summary. A [`Tally`] takes what one look at
+//! each run gives as the runs arrive; [`statistics`] completes it by passes over the runs,
+//! in memory that does not grow with their number.
 
+use super::runs::Runs;
+use super::select::{ExactSum, RadixSelect, from_ordered_key, ordered_key};
 use super::table::{Row, RunStatus};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -117,60 +121,340 @@ pub struct RankRule {
     pub missing: f64,
 }
 
-/// Counts each status.
-pub fn status_counts(rows: &[Row]) -> StatusCounts {
-    let mut c = StatusCounts::default();
-    for r in rows {
-        match r.status {
-            RunStatus::Complete => c.complete += 1,
-            RunStatus::Stopped => c.stopped += 1,
-            RunStatus::Failed => c.failed += 1,
-            RunStatus::Invalid => c.invalid += 1,
-            RunStatus::InvalidModel => c.invalid_model += 1,
-        }
-    }
-    c
+/// What the summary needs of one event column.
+#[derive(Debug, Clone)]
+pub struct EventColumn {
+    /// Its condition, e.g. `nutation_angle_deg above 80`.
+    pub condition: String,
+    /// Its column name.
+    pub name: String,
+    /// Its column index.
+    pub column: usize,
 }
 
-/// Statistics of column `j` over usable runs (None when no run has a value).
-pub fn column_stats(name: &str, j: usize, rows: &[Row]) -> Option<ColumnStats> {
-    let mut v: Vec<f64> = rows
-        .iter()
-        .filter(|r| r.status.ok())
-        .filter_map(|r| r.values[j])
-        .filter(|x| x.is_finite())
-        .collect();
-    if v.is_empty() {
-        return None;
+/// Everything the summary is computed from, besides the runs.
+#[derive(Debug, Clone)]
+pub struct SummarySpec {
+    /// Column names.
+    pub columns: Vec<String>,
+    /// The event columns.
+    pub events: Vec<EventColumn>,
+    /// Times for the event probabilities (s).
+    pub probability_by: Vec<f64>,
+    /// How runs are ranked.
+    pub rank: RankRule,
+}
+
+/// One column's counts in the first pass.
+#[derive(Debug, Clone)]
+struct ColumnTally {
+    count: u64,
+    min: u64,
+    max: u64,
+    sum: ExactSum,
+}
+
+/// One event's counts in the first pass.
+#[derive(Debug, Clone, Default)]
+struct EventTally {
+    reached: usize,
+    by: Vec<usize>,
+}
+
+/// The statistics that need one look at each run, taken as runs are pushed in run order:
+/// counts, first failures, extremes and exact sums. Holds a fixed amount whatever the number
+/// of runs.
+#[derive(Debug, Clone)]
+pub struct Tally {
+    spec: SummarySpec,
+    runs: usize,
+    usable: usize,
+    status: StatusCounts,
+    failures: Vec<Failure>,
+    events: Vec<EventTally>,
+    columns: Vec<ColumnTally>,
+    /// Worst and best (key, run) under the rank rule, and the number of usable runs ranked.
+    worst: Option<(u64, u64)>,
+    best: Option<(u64, u64)>,
+}
+
+impl Tally {
+    /// An empty tally.
+    pub fn new(spec: SummarySpec) -> Self {
+        let column = ColumnTally {
+            count: 0,
+            min: u64::MAX,
+            max: 0,
+            sum: ExactSum::default(),
+        };
+        Self {
+            events: vec![
+                EventTally {
+                    reached: 0,
+                    by: vec![0; spec.probability_by.len()],
+                };
+                spec.events.len()
+            ],
+            columns: vec![column; spec.columns.len()],
+            spec,
+            runs: 0,
+            usable: 0,
+            status: StatusCounts::default(),
+            failures: Vec::new(),
+            worst: None,
+            best: None,
+        }
     }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    // Two-pass mean and variance: sums in run order would depend on the order of the table,
-    // sums of the sorted values do not.
-    let mean = v.iter().sum::<f64>() / n as f64;
-    let sd = if n > 1 {
-        (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
+
+    /// Counts `r` (runs must come in run order).
+    pub fn add(&mut self, r: &Row) {
+        self.runs += 1;
+        match r.status {
+            RunStatus::Complete => self.status.complete += 1,
+            RunStatus::Stopped => self.status.stopped += 1,
+            RunStatus::Failed => self.status.failed += 1,
+            RunStatus::Invalid => self.status.invalid += 1,
+            RunStatus::InvalidModel => self.status.invalid_model += 1,
+        }
+        if !r.status.ok() {
+            if self.failures.len() < LISTED_FAILURES {
+                self.failures.push(Failure {
+                    run: r.run,
+                    status: r.status.label(),
+                    message: r.message.clone(),
+                });
+            }
+            return;
+        }
+        self.usable += 1;
+        for (e, tally) in self.spec.events.iter().zip(&mut self.events) {
+            if let Some(t) = r.values[e.column] {
+                tally.reached += 1;
+                for (count, by) in tally.by.iter_mut().zip(&self.spec.probability_by) {
+                    *count += usize::from(t <= *by);
+                }
+            }
+        }
+        for (c, v) in self.columns.iter_mut().zip(&r.values) {
+            if let Some(x) = v.filter(|x| x.is_finite()) {
+                let k = ordered_key(x);
+                c.count += 1;
+                c.min = c.min.min(k);
+                c.max = c.max.max(k);
+                c.sum.add(x);
+            }
+        }
+        let key = self.spec.rank.key(&r.values);
+        if self.worst.is_none_or(|(k, _)| key < k) {
+            self.worst = Some((key, r.run));
+        }
+        if self.best.is_none_or(|(k, _)| key >= k) {
+            self.best = Some((key, r.run));
+        }
+    }
+
+    /// Number of runs counted.
+    pub fn runs(&self) -> usize {
+        self.runs
+    }
+
+    /// Whether some usable run has a value in event column `k` (of the spec's events).
+    pub fn event_reached(&self, k: usize) -> bool {
+        self.events[k].reached > 0
+    }
+}
+
+impl RankRule {
+    /// A usable run's ranking key: ascending from the worst run.
+    fn key(&self, values: &[Option<f64>]) -> u64 {
+        let k = ordered_key(values[self.column].unwrap_or(self.missing));
+        if self.smaller_is_worse { k } else { !k }
+    }
+}
+
+/// The statistics of a campaign.
+#[derive(Debug, Clone)]
+pub struct Statistics {
+    /// Counts of each status.
+    pub status: StatusCounts,
+    /// Per event.
+    pub events: Vec<EventStats>,
+    /// The worst, median and best runs.
+    pub ranking: Option<Ranking>,
+    /// Per column with values.
+    pub columns: Vec<ColumnStats>,
+    /// The first failed or invalid runs.
+    pub failures: Vec<Failure>,
+}
+
+/// Completes `tally` by passes over `runs` (the runs it counted, in the same order): the
+/// percentiles and the median run by exact radix selection ([`select::PASSES`] passes),
+/// the standard deviations around the exact mean, and the median's tie-break by run index
+/// (one more pass). Gives the same bits whatever held the runs.
+pub fn statistics(tally: &Tally, runs: &dyn Runs) -> Result<Statistics, String> {
+    let spec = &tally.spec;
+    // Ranks of each column's order statistics: for every percentile, the two around it.
+    let ranks: Vec<Vec<u64>> = tally
+        .columns
+        .iter()
+        .map(|c| {
+            if c.count == 0 {
+                return Vec::new();
+            }
+            PERCENTILES
+                .iter()
+                .flat_map(|p| {
+                    let (lo, hi, _) = percentile_ranks(c.count, *p);
+                    [lo, hi]
+                })
+                .collect()
+        })
+        .collect();
+    let mut selections: Vec<RadixSelect> = ranks.iter().map(|r| RadixSelect::new(r)).collect();
+    let median_rank = (tally.usable as u64).saturating_sub(1) / 2;
+    let median_ranks = if tally.usable > 0 {
+        vec![median_rank]
     } else {
-        0.0
+        Vec::new()
     };
-    Some(ColumnStats {
-        column: name.to_string(),
-        count: n,
-        mean,
-        sd,
-        min: v[0],
-        percentiles: PERCENTILES.iter().map(|p| percentile(&v, *p)).collect(),
-        max: v[n - 1],
+    let mut median = RadixSelect::new(&median_ranks);
+    let means: Vec<f64> = tally
+        .columns
+        .iter()
+        .map(|c| c.sum.value() / c.count.max(1) as f64)
+        .collect();
+    let mut squares = vec![ExactSum::default(); spec.columns.len()];
+    let mut first = true;
+    while !(median.done() && selections.iter().all(RadixSelect::done)) || first {
+        runs.scan(&mut |r| {
+            if !r.ok {
+                return;
+            }
+            for (j, v) in r.values.iter().enumerate() {
+                if let Some(x) = v.filter(|x| x.is_finite()) {
+                    selections[j].observe(ordered_key(x));
+                    if first {
+                        squares[j].add((x - means[j]).powi(2));
+                    }
+                }
+            }
+            median.observe(spec.rank.key(r.values));
+        })?;
+        selections.iter_mut().for_each(RadixSelect::end_pass);
+        median.end_pass();
+        first = false;
+    }
+    let ranking = match (tally.worst, tally.best) {
+        (Some((_, worst)), Some((_, best))) => {
+            let key = median.key(median_rank);
+            let mut skip = median.rank_among_equals(median_rank);
+            let mut run = None;
+            runs.scan(&mut |r| {
+                if r.ok && run.is_none() && spec.rank.key(r.values) == key {
+                    if skip == 0 {
+                        run = Some(r.run);
+                    } else {
+                        skip -= 1;
+                    }
+                }
+            })?;
+            Some(Ranking {
+                by: spec.rank.name.clone(),
+                worst_is: if spec.rank.smaller_is_worse {
+                    "smallest"
+                } else {
+                    "largest"
+                }
+                .into(),
+                worst,
+                median: run.ok_or("the median run was not found on the second reading")?,
+                best,
+            })
+        }
+        _ => None,
+    };
+    let columns = tally
+        .columns
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.count > 0)
+        .map(|(j, c)| {
+            let n = c.count;
+            let s = &selections[j];
+            ColumnStats {
+                column: spec.columns[j].clone(),
+                count: n as usize,
+                mean: means[j],
+                sd: if n > 1 {
+                    (squares[j].value() / (n - 1) as f64).sqrt()
+                } else {
+                    0.0
+                },
+                min: from_ordered_key(c.min),
+                percentiles: PERCENTILES
+                    .iter()
+                    .map(|p| {
+                        let (lo, hi, frac) = percentile_ranks(n, *p);
+                        let (a, b) = (from_ordered_key(s.key(lo)), from_ordered_key(s.key(hi)));
+                        a + frac * (b - a)
+                    })
+                    .collect(),
+                max: from_ordered_key(c.max),
+            }
+        })
+        .collect();
+    let usable = tally.usable;
+    let events = spec
+        .events
+        .iter()
+        .zip(&tally.events)
+        .map(|(e, t)| EventStats {
+            condition: e.condition.clone(),
+            column: e.name.clone(),
+            runs: usable,
+            excluded: tally.runs - usable,
+            excluded_invalid_model: tally.status.invalid_model,
+            reached: t.reached,
+            by: spec
+                .probability_by
+                .iter()
+                .zip(&t.by)
+                .map(|(&t, &k)| ProbabilityBy {
+                    t,
+                    count: k,
+                    probability: if usable > 0 {
+                        k as f64 / usable as f64
+                    } else {
+                        f64::NAN
+                    },
+                    ci95: wilson95(k, usable),
+                })
+                .collect(),
+        })
+        .collect();
+    Ok(Statistics {
+        status: tally.status.clone(),
+        events,
+        ranking,
+        columns,
+        failures: tally.failures.clone(),
     })
+}
+
+/// The order statistics (0-based ranks) around the `p`-th percentile of `n` values and the
+/// fraction between them, as [`percentile`] interpolates.
+fn percentile_ranks(n: u64, p: f64) -> (u64, u64, f64) {
+    let h = (n - 1) as f64 * p / 100.0;
+    let lo = h.floor() as u64;
+    (lo, (lo + 1).min(n - 1), h - lo as f64)
 }
 
 /// The `p`-th percentile of sorted `v` by linear interpolation between order statistics
 /// (Hyndman and Fan's definition 7, the default of NumPy and R).
 pub fn percentile(v: &[f64], p: f64) -> f64 {
-    let h = (v.len() - 1) as f64 * p / 100.0;
-    let lo = h.floor() as usize;
-    let hi = (lo + 1).min(v.len() - 1);
-    v[lo] + (h - lo as f64) * (v[hi] - v[lo])
+    let (lo, hi, frac) = percentile_ranks(v.len() as u64, p);
+    let (a, b) = (v[lo as usize], v[hi as usize]);
+    a + frac * (b - a)
 }
 
 /// The 95 % Wilson score interval for `k` successes in `n` trials (Wilson 1927); it stays
@@ -186,82 +470,6 @@ pub fn wilson95(k: usize, n: usize) -> [f64; 2] {
     let centre = (p + z * z / (2.0 * n)) / denom;
     let half = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / denom;
     [(centre - half).max(0.0), (centre + half).min(1.0)]
-}
-
-/// Statistics of an event time column.
-pub fn event_stats(condition: &str, name: &str, j: usize, rows: &[Row], by: &[f64]) -> EventStats {
-    let usable: Vec<&Row> = rows.iter().filter(|r| r.status.ok()).collect();
-    let n = usable.len();
-    let times: Vec<f64> = usable.iter().filter_map(|r| r.values[j]).collect();
-    EventStats {
-        condition: condition.to_string(),
-        column: name.to_string(),
-        runs: n,
-        excluded: rows.len() - n,
-        excluded_invalid_model: rows
-            .iter()
-            .filter(|r| r.status == RunStatus::InvalidModel)
-            .count(),
-        reached: times.len(),
-        by: by
-            .iter()
-            .map(|&t| {
-                let k = times.iter().filter(|&&x| x <= t).count();
-                ProbabilityBy {
-                    t,
-                    count: k,
-                    probability: if n > 0 { k as f64 / n as f64 } else { f64::NAN },
-                    ci95: wilson95(k, n),
-                }
-            })
-            .collect(),
-    }
-}
-
-/// The worst, median and best usable runs under `rule` (ties broken by run index).
-pub fn rank(rows: &[Row], rule: &RankRule) -> Option<Ranking> {
-    let mut keyed: Vec<(f64, u64)> = rows
-        .iter()
-        .filter(|r| r.status.ok())
-        .map(|r| (r.values[rule.column].unwrap_or(rule.missing), r.run))
-        .collect();
-    if keyed.is_empty() {
-        return None;
-    }
-    // Worst first.
-    keyed.sort_by(|a, b| {
-        let by_value = if rule.smaller_is_worse {
-            a.0.total_cmp(&b.0)
-        } else {
-            b.0.total_cmp(&a.0)
-        };
-        by_value.then(a.1.cmp(&b.1))
-    });
-    Some(Ranking {
-        by: rule.name.clone(),
-        worst_is: if rule.smaller_is_worse {
-            "smallest"
-        } else {
-            "largest"
-        }
-        .into(),
-        worst: keyed[0].1,
-        median: keyed[(keyed.len() - 1) / 2].1,
-        best: keyed[keyed.len() - 1].1,
-    })
-}
-
-/// The first [`LISTED_FAILURES`] failed or invalid runs.
-pub fn failures(rows: &[Row]) -> Vec<Failure> {
-    rows.iter()
-        .filter(|r| !r.status.ok())
-        .take(LISTED_FAILURES)
-        .map(|r| Failure {
-            run: r.run,
-            status: r.status.label(),
-            message: r.message.clone(),
-        })
-        .collect()
 }
 
 /// A number for the text summary: 6 significant digits.
@@ -372,7 +580,99 @@ mod tests {
             smaller_is_worse: true,
             missing: f64::INFINITY,
         };
-        let r = rank(&rows, &rule).unwrap();
+        let spec = SummarySpec {
+            columns: vec!["t".into()],
+            events: Vec::new(),
+            probability_by: Vec::new(),
+            rank: rule,
+        };
+        let mut tally = Tally::new(spec);
+        rows.iter().for_each(|r| tally.add(r));
+        let r = statistics(&tally, &rows.as_slice())
+            .unwrap()
+            .ranking
+            .unwrap();
         assert_eq!((r.worst, r.median, r.best), (2, 0, 1));
+    }
+
+    #[test]
+    fn streamed_statistics_equal_those_of_the_sorted_values() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let status = [RunStatus::Complete, RunStatus::Stopped, RunStatus::Failed];
+        let rows: Vec<Row> = (0..3001)
+            .map(|run| Row {
+                run,
+                status: status[(run % 3) as usize],
+                message: String::new(),
+                values: vec![
+                    Some(rng.random::<f64>() * 100.0),
+                    (run % 5 != 0).then(|| (rng.random_range(0..20) as f64).exp()),
+                    Some(if run % 7 == 0 {
+                        f64::INFINITY
+                    } else {
+                        -(run as f64)
+                    }),
+                ],
+            })
+            .collect();
+        let spec = SummarySpec {
+            columns: vec!["a".into(), "b".into(), "c".into()],
+            events: Vec::new(),
+            probability_by: Vec::new(),
+            rank: RankRule {
+                column: 1,
+                name: "b".into(),
+                smaller_is_worse: false,
+                missing: f64::NEG_INFINITY,
+            },
+        };
+        let mut tally = Tally::new(spec);
+        rows.iter().for_each(|r| tally.add(r));
+        let stats = statistics(&tally, &rows.as_slice()).unwrap();
+        let usable: Vec<&Row> = rows.iter().filter(|r| r.status.ok()).collect();
+        for (j, c) in stats.columns.iter().enumerate() {
+            let mut v: Vec<f64> = usable
+                .iter()
+                .filter_map(|r| r.values[j])
+                .filter(|x| x.is_finite())
+                .collect();
+            v.sort_by(f64::total_cmp);
+            assert_eq!(c.count, v.len());
+            assert_eq!((c.min, c.max), (v[0], v[v.len() - 1]));
+            for (p, got) in PERCENTILES.iter().zip(&c.percentiles) {
+                assert_eq!(
+                    got.to_bits(),
+                    percentile(&v, *p).to_bits(),
+                    "{} p{p}",
+                    c.column
+                );
+            }
+            let mean = v.iter().sum::<f64>() / v.len() as f64;
+            assert!(
+                (c.mean - mean).abs() <= 1e-13 * mean.abs(),
+                "{} {mean}",
+                c.column
+            );
+            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+            assert!(
+                (c.sd - var.sqrt()).abs() <= 1e-12 * var.sqrt(),
+                "{}",
+                c.column
+            );
+        }
+        // Ranking by b, largest worst, a missing b counting as -inf (best), ties by run.
+        let mut keyed: Vec<(f64, u64)> = usable
+            .iter()
+            .map(|r| (r.values[1].unwrap_or(f64::NEG_INFINITY), r.run))
+            .collect();
+        keyed.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let r = stats.ranking.unwrap();
+        let median = keyed[(keyed.len() - 1) / 2].1;
+        assert_eq!(
+            (r.worst, r.median, r.best),
+            (keyed[0].1, median, keyed[keyed.len() - 1].1)
+        );
+        assert_eq!(stats.status.failed, 1000);
     }
 }
