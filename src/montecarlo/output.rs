@@ -66,6 +66,22 @@ fn is_event_chart(name: &str) -> bool {
         && EVENT_CHART_SUFFIXES.iter().any(|s| stem.ends_with(s))
 }
 
+/// Whether `name` is a temporary name ([`temporary_name`]) of a campaign's file.
+fn is_temporary(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let Some((file, pid)) = rest.rsplit_once('.') else {
+        return false;
+    };
+    !pid.is_empty()
+        && pid.bytes().all(|b| b.is_ascii_digit())
+        && (file == SCRATCH_FILE || OUTPUT_FILES.contains(&file) || is_event_chart(file))
+}
+
+/// The scratch file of the runs' values, under its temporary name while a campaign writes.
+const SCRATCH_FILE: &str = "runs.scratch";
+
 /// Removes a previous campaign's outputs from `dir` (the manifest first).
 pub fn clear_outputs(dir: &Path) -> Result<(), String> {
     let remove = |p: PathBuf| match std::fs::remove_file(&p) {
@@ -82,9 +98,13 @@ pub fn clear_outputs(dir: &Path) -> Result<(), String> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(format!("cannot list {}: {e}", dir.display())),
     };
+    // And the temporaries of a campaign that was killed while it wrote (`.<file>.<pid>.tmp`).
     let mut old: Vec<PathBuf> = entries
         .filter_map(Result::ok)
-        .filter(|e| is_event_chart(&e.file_name().to_string_lossy()))
+        .filter(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            is_event_chart(&name) || is_temporary(&name)
+        })
         .map(|e| e.path())
         .collect();
     old.sort();
@@ -218,7 +238,7 @@ impl<'a> CampaignWriter<'a> {
             let csv = CsvWriter::new(csv_file, &prep.columns).map_err(io)?;
             let parquet = ParquetWriter::new(parquet_file, &prep.columns)
                 .map_err(|e| format!("cannot write runs.parquet: {e}"))?;
-            let store = RunStore::create(&temporary_name(dir, "runs.scratch"), prep.columns.len())?;
+            let store = RunStore::create(&temporary_name(dir, SCRATCH_FILE), prep.columns.len())?;
             Ok::<_, String>((csv, parquet, store))
         })();
         let (csv, parquet, store) = match result {
