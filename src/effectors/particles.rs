@@ -146,55 +146,190 @@ fn cross_matrix(r: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -r.z, r.y, r.z, 0.0, -r.x, -r.y, r.x, 0.0)
 }
 
-/// In-place Cholesky of the n × n row-major `a` (lower triangle read and written); returns
-/// false if not positive definite.
-fn cholesky(a: &mut [f64], n: usize) -> bool {
+/// In-place Cholesky of the leading n × n block of `a` (lower triangle read and written);
+/// returns false if not positive definite. (Indexed loops, as the algorithm is written.)
+#[allow(clippy::needless_range_loop)]
+fn cholesky<const N: usize>(a: &mut [[f64; N]; N], n: usize) -> bool {
     for j in 0..n {
-        let mut d = a[j * n + j];
+        let mut d = a[j][j];
         for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
+            d -= a[j][k] * a[j][k];
         }
         if d.is_nan() || d <= 0.0 {
             return false;
         }
         let d = d.sqrt();
-        a[j * n + j] = d;
+        a[j][j] = d;
         for i in j + 1..n {
-            let mut s = a[i * n + j];
+            let mut s = a[i][j];
             for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
+                s -= a[i][k] * a[j][k];
             }
-            a[i * n + j] = s / d;
+            a[i][j] = s / d;
         }
     }
     true
 }
 
-/// Solves L Lᵀ X = B in place for `m` right-hand sides (`b` row-major n × m; `l` from
-/// [`cholesky`]).
-fn cholesky_solve_many(l: &[f64], n: usize, b: &mut [f64], m: usize) {
+/// Solves L Lᵀ X = B in place for the 7 right-hand sides of the first n rows of `b` (`l`
+/// from [`cholesky`]). (Indexed loops, as the algorithm is written.)
+#[allow(clippy::needless_range_loop)]
+fn cholesky_solve7<const N: usize>(l: &[[f64; N]; N], n: usize, b: &mut [[f64; 7]; N]) {
     for i in 0..n {
         for k in 0..i {
-            let lik = l[i * n + k];
-            for c in 0..m {
-                b[i * m + c] -= lik * b[k * m + c];
+            let lik = l[i][k];
+            for c in 0..7 {
+                b[i][c] -= lik * b[k][c];
             }
         }
-        let d = l[i * n + i];
-        for c in 0..m {
-            b[i * m + c] /= d;
+        let d = l[i][i];
+        for c in 0..7 {
+            b[i][c] /= d;
         }
     }
     for i in (0..n).rev() {
         for k in i + 1..n {
-            let lki = l[k * n + i];
-            for c in 0..m {
-                b[i * m + c] -= lki * b[k * m + c];
+            let lki = l[k][i];
+            for c in 0..7 {
+                b[i][c] -= lki * b[k][c];
             }
         }
-        let d = l[i * n + i];
-        for c in 0..m {
-            b[i * m + c] /= d;
+        let d = l[i][i];
+        for c in 0..7 {
+            b[i][c] /= d;
+        }
+    }
+}
+
+impl<P: ParticleModel> ParticleEffector<P> {
+    /// [`Effector::couple`] for `N` coordinates when `N` is below [`MAX_COORDINATES`] (the
+    /// loops then have fixed bounds, and the compiler unrolls them and keeps the small
+    /// matrices in registers), or for any number up to `N` = [`MAX_COORDINATES`], taken at
+    /// run time. The arithmetic, and so every bit of the result, is the same either way.
+    fn couple_sized<const N: usize>(
+        &self,
+        hub: &HubState,
+        x: &[f64],
+        coupling: &mut HubCoupling,
+        scratch: &mut [f64],
+    ) {
+        let n = if N < MAX_COORDINATES {
+            N
+        } else {
+            self.model.num_coordinates()
+        };
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let w = hub.omega;
+        // M (lower triangle), Cᵀ (n × 6) and g (n).
+        let mut mass = [[0.0; N]; N];
+        let mut ct = [[0.0; 6]; N];
+        let mut g = [0.0; N];
+        let mut d_rr = Matrix3::zeros();
+        let (mut m_sum, mut s_sum) = (0.0, Vector3::zeros());
+        let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
+        let mut pt = ParticlePoint::default();
+        let cache = self.model.prepare(q, u);
+        let mut tidal = coupling.tidal;
+        for p in 0..self.model.num_particles() {
+            self.model.particle(p, &cache, q, u, &mut pt);
+            let m = pt.mass;
+            let r = pt.position;
+            let jac = &pt.jacobian[..n];
+            let mut v_rel = Vector3::zeros();
+            for (k, j) in jac.iter().enumerate() {
+                v_rel += j * u[k];
+            }
+            if let Some(field) = &mut tidal {
+                // The gravity gradient's tidal force on this particle: an external force on
+                // the coordinates (Jᵀ f) and on the system (f, r × f).
+                let f = m * (field.gradient * r);
+                for k in 0..n {
+                    g[k] += jac[k].dot(&f);
+                }
+                let moment = r.cross(&f);
+                for i in 0..3 {
+                    coupling.force[i] += f[i];
+                    coupling.force[3 + i] += moment[i];
+                }
+                let v = w.cross(&r) + v_rel;
+                field.relative_power += f.dot(&v);
+                field.first_moment += m * r;
+                field.relative_momentum += m * v;
+                field.moving_mass += m;
+            }
+            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
+            for k in 0..n {
+                let jk = jac[k];
+                for l in 0..=k {
+                    mass[k][l] += m * jk.dot(&jac[l]);
+                }
+                let rj = r.cross(&jk);
+                let row = &mut ct[k];
+                row[0] += m * jk.x;
+                row[1] += m * jk.y;
+                row[2] += m * jk.z;
+                row[3] += m * rj.x;
+                row[4] += m * rj.y;
+                row[5] += m * rj.z;
+                g[k] -= m * jk.dot(&c);
+            }
+            m_sum += m;
+            s_sum += m * r;
+            d_rr += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+            e_t += m * c;
+            e_r += m * r.cross(&c);
+        }
+        coupling.tidal = tidal;
+        let mut forces = [0.0; MAX_COORDINATES];
+        self.model.forces(q, u, &mut forces[..n]);
+        for k in 0..n {
+            g[k] += forces[k];
+        }
+        // D and e.
+        let sx = cross_matrix(&s_sum);
+        for i in 0..3 {
+            coupling.mass[(i, i)] += m_sum;
+        }
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(0, 3);
+        block -= sx;
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 0);
+        block += sx;
+        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 3);
+        block += d_rr;
+        for i in 0..3 {
+            coupling.force[i] -= e_t[i];
+            coupling.force[3 + i] -= e_r[i];
+        }
+        coupling.translation = true;
+        let kept = &mut scratch[..7 * n];
+        if !cholesky(&mut mass, n) {
+            // A degenerate configuration: poison the hub solve, so the run stops with a
+            // diagnosis rather than continuing with nonsense.
+            coupling.force[0] = f64::NAN;
+            kept.fill(f64::NAN);
+            return;
+        }
+        // Y = M⁻¹ Cᵀ (n × 6) and y_g = M⁻¹ g, kept for `derivatives`: one solve with 7
+        // right-hand sides [g | Cᵀ], written to the scratch row-major with stride 7.
+        let mut rhs = [[0.0; 7]; N];
+        for k in 0..n {
+            rhs[k][0] = g[k];
+            rhs[k][1..].copy_from_slice(&ct[k]);
+        }
+        cholesky_solve7(&mass, n, &mut rhs);
+        for k in 0..n {
+            kept[k * 7..k * 7 + 7].copy_from_slice(&rhs[k]);
+        }
+        // mass −= C Y ; force −= C y_g, with C = (Cᵀ)ᵀ.
+        for k in 0..n {
+            let ck = &ct[k];
+            let yk = &rhs[k];
+            for (a, &cka) in ck.iter().enumerate() {
+                coupling.force[a] -= cka * yk[0];
+                for b in 0..6 {
+                    coupling.mass[(a, b)] -= cka * yk[1 + b];
+                }
+            }
         }
     }
 }
@@ -233,124 +368,15 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
         true
     }
     fn scratch_len(&self) -> usize {
-        // y_g (n), Y (6n); workspace: M (n²), Cᵀ (6n), g (n).
-        let n = self.model.num_coordinates();
-        14 * n + n * n
+        // y_g (n) and Y (6n), kept from `couple` for `derivatives`.
+        7 * self.model.num_coordinates()
     }
 
     fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let n = self.model.num_coordinates();
-        let (q, u) = (&x[..n], &x[n..2 * n]);
-        let w = hub.omega;
-        let (kept, work) = scratch.split_at_mut(7 * n);
-        let (mass, work) = work.split_at_mut(n * n);
-        let (ct, g) = work.split_at_mut(6 * n);
-        // M (n × n, row-major), Cᵀ (n × 6, row-major), g (n).
-        mass.fill(0.0);
-        ct.fill(0.0);
-        g.fill(0.0);
-        let mut d_rr = Matrix3::zeros();
-        let (mut m_sum, mut s_sum) = (0.0, Vector3::zeros());
-        let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
-        let mut pt = ParticlePoint::default();
-        let cache = self.model.prepare(q, u);
-        let mut tidal = coupling.tidal;
-        for p in 0..self.model.num_particles() {
-            self.model.particle(p, &cache, q, u, &mut pt);
-            let m = pt.mass;
-            let r = pt.position;
-            let jac = &pt.jacobian[..n];
-            let mut v_rel = Vector3::zeros();
-            for (k, j) in jac.iter().enumerate() {
-                v_rel += j * u[k];
-            }
-            if let Some(field) = &mut tidal {
-                // The gravity gradient's tidal force on this particle: an external force on
-                // the coordinates (Jᵀ f) and on the system (f, r × f).
-                let f = m * (field.gradient * r);
-                for k in 0..n {
-                    g[k] += jac[k].dot(&f);
-                }
-                let moment = r.cross(&f);
-                for i in 0..3 {
-                    coupling.force[i] += f[i];
-                    coupling.force[3 + i] += moment[i];
-                }
-                let v = w.cross(&r) + v_rel;
-                field.relative_power += f.dot(&v);
-                field.first_moment += m * r;
-                field.relative_momentum += m * v;
-                field.moving_mass += m;
-            }
-            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
-            for k in 0..n {
-                let jk = jac[k];
-                for l in 0..=k {
-                    mass[k * n + l] += m * jk.dot(&jac[l]);
-                }
-                let rj = r.cross(&jk);
-                let row = &mut ct[k * 6..k * 6 + 6];
-                row[0] += m * jk.x;
-                row[1] += m * jk.y;
-                row[2] += m * jk.z;
-                row[3] += m * rj.x;
-                row[4] += m * rj.y;
-                row[5] += m * rj.z;
-                g[k] -= m * jk.dot(&c);
-            }
-            m_sum += m;
-            s_sum += m * r;
-            d_rr += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
-            e_t += m * c;
-            e_r += m * r.cross(&c);
-        }
-        coupling.tidal = tidal;
-        let mut forces = [0.0; MAX_COORDINATES];
-        self.model.forces(q, u, &mut forces[..n]);
-        for k in 0..n {
-            g[k] += forces[k];
-        }
-        // D and e.
-        let sx = cross_matrix(&s_sum);
-        for i in 0..3 {
-            coupling.mass[(i, i)] += m_sum;
-        }
-        let mut block = coupling.mass.fixed_view_mut::<3, 3>(0, 3);
-        block -= sx;
-        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 0);
-        block += sx;
-        let mut block = coupling.mass.fixed_view_mut::<3, 3>(3, 3);
-        block += d_rr;
-        for i in 0..3 {
-            coupling.force[i] -= e_t[i];
-            coupling.force[3 + i] -= e_r[i];
-        }
-        coupling.translation = true;
-        if !cholesky(mass, n) {
-            // A degenerate configuration: poison the hub solve, so the run stops with a
-            // diagnosis rather than continuing with nonsense.
-            coupling.force[0] = f64::NAN;
-            kept.fill(f64::NAN);
-            return;
-        }
-        // Y = M⁻¹ Cᵀ (n × 6) and y_g = M⁻¹ g, kept for `derivatives`: one solve with 7
-        // right-hand sides, [g | Cᵀ] row-major with stride 7.
-        let rhs = &mut kept[..7 * n];
-        for k in 0..n {
-            rhs[k * 7] = g[k];
-            rhs[k * 7 + 1..k * 7 + 7].copy_from_slice(&ct[k * 6..k * 6 + 6]);
-        }
-        cholesky_solve_many(mass, n, rhs, 7);
-        // mass −= C Y ; force −= C y_g, with C = (Cᵀ)ᵀ.
-        for k in 0..n {
-            let ck = &ct[k * 6..k * 6 + 6];
-            let yk = &rhs[k * 7..k * 7 + 7];
-            for (a, &cka) in ck.iter().enumerate() {
-                coupling.force[a] -= cka * yk[0];
-                for b in 0..6 {
-                    coupling.mass[(a, b)] -= cka * yk[1 + b];
-                }
-            }
+        match self.model.num_coordinates() {
+            1 => self.couple_sized::<1>(hub, x, coupling, scratch),
+            2 => self.couple_sized::<2>(hub, x, coupling, scratch),
+            _ => self.couple_sized::<MAX_COORDINATES>(hub, x, coupling, scratch),
         }
     }
 
@@ -454,19 +480,86 @@ mod tests {
     #[test]
     fn cholesky_solves_a_small_system_with_several_right_hand_sides() {
         let m = [[4.0, 2.0, 0.6], [2.0, 5.0, 1.0], [0.6, 1.0, 3.0]];
-        let mut a: Vec<f64> = m.concat();
+        // In a larger array: only the leading 3 × 3 block is used.
+        let mut a = [[0.0; 4]; 4];
+        for (i, row) in m.iter().enumerate() {
+            a[i][..3].copy_from_slice(row);
+        }
         assert!(cholesky(&mut a, 3));
-        // Two right-hand sides, row-major 3 × 2.
-        let rhs = [[1.0, 0.3], [-2.0, 0.0], [0.5, -1.0]];
-        let mut b: Vec<f64> = rhs.concat();
-        cholesky_solve_many(&a, 3, &mut b, 2);
-        for c in 0..2 {
+        let rhs: [[f64; 7]; 3] =
+            std::array::from_fn(|i| std::array::from_fn(|c| (i * 7 + c) as f64 - 9.5));
+        let mut b = [[0.0; 7]; 4];
+        b[..3].copy_from_slice(&rhs);
+        cholesky_solve7(&a, 3, &mut b);
+        for c in 0..7 {
             for (i, row) in m.iter().enumerate() {
-                let r: f64 = (0..3).map(|k| row[k] * b[k * 2 + c]).sum();
-                assert!((r - rhs[i][c]).abs() < 1e-14);
+                let r: f64 = (0..3).map(|k| row[k] * b[k][c]).sum();
+                assert!((r - rhs[i][c]).abs() < 1e-13, "{r} {}", rhs[i][c]);
             }
         }
-        let mut singular = vec![0.0; 4];
+        let mut singular = [[0.0; 2]; 2];
         assert!(!cholesky(&mut singular, 2));
+    }
+
+    /// The fixed-size coupling (one or two coordinates) and the general one give the same
+    /// bits: the same arithmetic, in the same order.
+    #[test]
+    fn fixed_size_coupling_equals_the_general_one_bit_for_bit() {
+        use super::super::hinged_rod::{HingeFreedom, HingedRod};
+        use super::super::spring_mass::SpringMass;
+        use nalgebra::{Matrix6, Vector6};
+        fn both<P: ParticleModel>(e: &ParticleEffector<P>, x: &[f64]) {
+            let hub = HubState {
+                t: 0.3,
+                omega: Vector3::new(0.3, -0.2, 7.5),
+                attitude: &[1.0, 0.0, 0.0, 0.0],
+            };
+            let start = HubCoupling {
+                mass: Matrix6::identity() * 3.0,
+                force: Vector6::new(0.0, 0.0, 0.0, 0.1, -0.2, 0.3),
+                translation: false,
+                tidal: None,
+            };
+            let n = e.model.num_coordinates();
+            let (mut fixed, mut general) = (start.clone(), start);
+            let (mut s1, mut s2) = (vec![0.0; 7 * n], vec![0.0; 7 * n]);
+            match n {
+                1 => e.couple_sized::<1>(&hub, x, &mut fixed, &mut s1),
+                _ => e.couple_sized::<2>(&hub, x, &mut fixed, &mut s1),
+            }
+            e.couple_sized::<MAX_COORDINATES>(&hub, x, &mut general, &mut s2);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(fixed.mass.as_slice()), bits(general.mass.as_slice()));
+            assert_eq!(bits(fixed.force.as_slice()), bits(general.force.as_slice()));
+            assert_eq!(bits(&s1), bits(&s2));
+            assert!(
+                fixed.mass != Matrix6::identity() * 3.0,
+                "the coupling added something"
+            );
+        }
+        let rod = |freedom| HingedRod {
+            mass: 0.3,
+            length: 1.2,
+            hinge: Vector3::new(0.1, 0.0, 0.4),
+            direction: Vector3::x(),
+            axis: Vector3::z(),
+            freedom,
+            stiffness: [2.0, 3.0],
+            damping: [0.1, 0.2],
+        };
+        let e = ParticleEffector::new("rod", rod(HingeFreedom::FlapLag), &[0.2, -0.4], &[1.1, 0.7]);
+        both(&e, &[0.2, -0.4, 1.1, 0.7, 0.0]);
+        let e = ParticleEffector::new("rod", rod(HingeFreedom::Lag), &[0.3], &[-0.5]);
+        both(&e, &[0.3, -0.5, 0.0]);
+        let damper = SpringMass {
+            mass: 0.5,
+            position: Vector3::new(0.0, 0.7, 0.2),
+            direction: Vector3::new(0.6, 0.0, 0.8),
+            stiffness: 40.0,
+            damping: 0.8,
+            travel: None,
+        };
+        let e = ParticleEffector::new("damper", damper, &[0.01], &[0.3]);
+        both(&e, &[0.01, 0.3, 0.0]);
     }
 }
