@@ -182,7 +182,7 @@ struct SummaryDoc {
 
 /// Writes a campaign's outputs into a directory as its runs finish, in run order: the CSV
 /// and Parquet tables row by row (under temporary names), the runs' values to a scratch file
-/// for the summary's later passes, and the one-look statistics ([`Tally`]). Its memory does
+/// for the summary's later passes, and the one-look statistics (`Tally`). Its memory does
 /// not grow with the number of runs. [`CampaignWriter::finish`] writes the rest; dropped
 /// before that, it leaves nothing behind.
 pub struct CampaignWriter<'a> {
