@@ -18,6 +18,7 @@ use crate::exact::TorqueFreeSolution;
 use crate::integrate::{Dop853, OdeSystem, Stepper, Tolerances};
 use crate::model::{HubState, Secular, SecularMotion, SecularRates, Spacecraft};
 use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion, Vector3};
+use std::cell::RefCell;
 use std::sync::Arc;
 
 /// The spacecraft's effectors driven by a prescribed torque-free hub motion.
@@ -26,6 +27,8 @@ struct Driven<'a> {
     motion: &'a TorqueFreeSolution,
     inertia: Matrix3<f64>,
     inertia_inv: Matrix3<f64>,
+    /// The state with the prescribed rates written in, reused from call to call.
+    state: RefCell<Vec<f64>>,
 }
 
 impl OdeSystem for Driven<'_> {
@@ -35,7 +38,9 @@ impl OdeSystem for Driven<'_> {
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let omega = self.motion.omega_at(t);
         let omega_dot = self.inertia_inv * (self.inertia * omega).cross(&omega);
-        let mut state = y.to_vec();
+        let mut state = self.state.borrow_mut();
+        state.clear();
+        state.extend_from_slice(y);
         state[..3].copy_from_slice(omega.as_slice());
         self.sc.rhs_prescribed(t, &state, &omega_dot, true, dydt);
         dydt[..3].copy_from_slice(omega_dot.as_slice());
@@ -113,6 +118,7 @@ pub fn periodic_response(
         inertia_inv: inertia
             .try_inverse()
             .ok_or("the locked inertia is singular")?,
+        state: RefCell::new(Vec::with_capacity(sc.dim())),
     };
     let n = layout.dynamic.len();
     let start = |x: &[f64]| -> Vec<f64> {
@@ -391,20 +397,16 @@ pub fn coupled_orbit(
 /// f(θ) = P(θ) / (sin²θ cos²θ), interpolated by Chebyshev's barycentric formula.
 #[derive(Debug)]
 pub struct DissipationTable {
-    h: f64,
     /// Moment about the symmetry axis and the transverse moment (kg m²).
     i_s: f64,
     i_t: f64,
-    /// Chebyshev nodes in θ (rad) on [a, b].
+    /// Chebyshev nodes in θ (rad) on [a, b], and their barycentric weights.
     nodes: Vec<f64>,
+    weights: Vec<f64>,
     /// f at each node, per effector (W).
     f: Vec<Vec<f64>>,
     a: f64,
     b: f64,
-    /// Work of the table: orbits solved and the time taken (s).
-    pub orbits: usize,
-    /// Wall time of the tabulation (s).
-    pub seconds: f64,
 }
 
 /// Nutation nodes per table.
@@ -418,7 +420,6 @@ impl DissipationTable {
     /// Tabulates the dissipation of `sc`'s effectors from the initial state `y0` toward the
     /// end state (the spin about the axis of most inertia), with shooting tolerance `rtol`.
     pub fn new(sc: &Spacecraft, y0: &[f64], layout: &Layout, rtol: f64) -> Result<Self, String> {
-        let started = std::time::Instant::now();
         let inertia = sc.system_inertia(y0);
         let body = crate::model::RigidBody::new(inertia)
             .map_err(|e| format!("the locked spacecraft's inertia: {e}"))?;
@@ -516,16 +517,21 @@ impl DissipationTable {
             guess = Some((orbit.x0, orbit.period, th));
         }
         f.extend(values);
+        // Barycentric weights of Chebyshev points of the first kind.
+        let weights = (0..NODES)
+            .map(|j| {
+                (if j % 2 == 0 { 1.0 } else { -1.0 })
+                    * (std::f64::consts::PI * (j as f64 + 0.5) / NODES as f64).sin()
+            })
+            .collect();
         Ok(DissipationTable {
-            h,
             i_s,
             i_t,
             nodes,
+            weights,
             f,
             a,
             b,
-            orbits: NODES,
-            seconds: started.elapsed().as_secs_f64(),
         })
     }
 
@@ -539,9 +545,10 @@ impl DissipationTable {
 
     /// Effector `k`'s averaged dissipation power (W) at `energy` (J).
     pub fn power(&self, k: usize, h: f64, energy: f64) -> f64 {
-        let th = self.theta(h, energy).clamp(self.a, self.b);
+        let theta = self.theta(h, energy);
+        let th = theta.clamp(self.a, self.b);
         let shape = {
-            let (s, c) = self.theta(h, energy).sin_cos();
+            let (s, c) = theta.sin_cos();
             (s * c).powi(2)
         };
         // Barycentric interpolation at Chebyshev points of the first kind.
@@ -552,17 +559,11 @@ impl DissipationTable {
             if d == 0.0 {
                 return self.f[j][k] * shape;
             }
-            let w = (if j % 2 == 0 { 1.0 } else { -1.0 })
-                * (std::f64::consts::PI * (j as f64 + 0.5) / self.nodes.len() as f64).sin();
+            let w = self.weights[j];
             num += w / d * self.f[j][k];
             den += w / d;
         }
         num / den * shape
-    }
-
-    /// |H| the table was made at (N m s).
-    pub fn h(&self) -> f64 {
-        self.h
     }
 }
 

@@ -241,20 +241,23 @@ fn campaign_interrupt() -> Arc<AtomicBool> {
 /// Combines the shards' outputs in `dirs` into the whole campaign's, in `out`.
 pub(super) fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
     use crate::montecarlo;
-    let interrupt = campaign_interrupt();
-    WRITING_OUTPUTS.store(true, Ordering::SeqCst);
-    let (written, rows) = match montecarlo::output::merge(dirs, out, &interrupt) {
+    let shards = match montecarlo::output::check_shards(dirs) {
         Ok(x) => x,
         Err(e) => {
-            // Refusals come before anything is written; a failure after that leaves no
-            // manifest.
-            let code = if out.join("campaign.json").exists() || !e.starts_with("cannot write") {
-                EXIT_BAD_INPUT
-            } else {
-                EXIT_IO
-            };
             eprintln!("error: {e}");
-            return code;
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let interrupt = campaign_interrupt();
+    WRITING_OUTPUTS.store(true, Ordering::SeqCst);
+    let (written, rows) = match shards.write(out, &interrupt) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!(
+                "error: {e}; the merged result in {} is incomplete (no campaign.json)",
+                out.display()
+            );
+            return EXIT_IO;
         }
     };
     if written.mcap_interrupted {

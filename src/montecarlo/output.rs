@@ -956,7 +956,7 @@ fn file_sha256(path: &Path) -> std::io::Result<String> {
         }
         hash.update(&block[..n]);
     }
-    Ok(hash.finalize().iter().map(|b| format!("{b:02x}")).collect())
+    Ok(super::hex(&hash.finalize()))
 }
 
 fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
@@ -1008,15 +1008,17 @@ fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
     })
 }
 
+/// Every shard of one campaign, checked by [`check_shards`] and ready to merge.
+pub struct ShardSet {
+    prep: Prepared,
+    /// The shards by index (1-based), and their count.
+    shards: BTreeMap<u64, ShardOutput>,
+    count: u64,
+}
+
 /// Checks that `dirs` hold every shard of one campaign exactly once, unaltered and finished,
-/// and writes the whole campaign's outputs into `out` (see [`CampaignWriter::finish`] for
-/// `interrupt`). Reads the shards' tables twice, a row at a time: to check every row before
-/// anything is written, then to write them. Returns what was written and the number of runs.
-pub fn merge(
-    dirs: &[PathBuf],
-    out: &Path,
-    interrupt: &AtomicBool,
-) -> Result<(Written, u64), String> {
+/// reading every row of their tables (one at a time); nothing is written.
+pub fn check_shards(dirs: &[PathBuf]) -> Result<ShardSet, String> {
     if dirs.is_empty() {
         return Err("expected the shard directories to merge".into());
     }
@@ -1130,11 +1132,28 @@ pub fn merge(
     if prep.columns != m0.columns {
         return Err("the shards were written with other table columns".into());
     }
-    // Every shard's rows: exactly its range's runs, in order.
-    let read = |each: &mut dyn FnMut(Row) -> Result<(), String>| -> Result<(), String> {
-        for (k, s) in &by_index {
+    let count = n;
+    let shards: BTreeMap<u64, ShardOutput> = shards
+        .into_iter()
+        .map(|s| (s.manifest.shard.map_or(0, |[k, _]| k), s))
+        .collect();
+    let set = ShardSet {
+        prep,
+        shards,
+        count,
+    };
+    set.read_rows(&mut |_| Ok(()))?;
+    Ok(set)
+}
+
+impl ShardSet {
+    /// Hands every shard's rows to `each`, in run order, checking that each shard holds
+    /// exactly its range's runs. An error of `each` is returned as it is.
+    fn read_rows(&self, each: &mut dyn FnMut(Row) -> Result<(), String>) -> Result<(), String> {
+        let runs = self.prep.campaign.runs;
+        for (k, s) in &self.shards {
             let d = s.dir.display();
-            let range = shard_range(m0.runs, *k, n);
+            let range = shard_range(runs, *k, self.count);
             let wrong = || {
                 format!(
                     "{d}/runs.csv does not hold exactly runs {} to {} of shard {k}",
@@ -1148,29 +1167,39 @@ pub fn merge(
             let file =
                 File::open(s.dir.join("runs.csv")).map_err(|e| format!("{d}/runs.csv: {e}"))?;
             let mut next = range.start;
-            table::read_csv(BufReader::new(file), &prep.columns, |row| {
-                if row.run != next || next >= range.end {
-                    return Err(wrong());
-                }
-                next += 1;
-                each(row)
-            })
-            .map_err(|e| {
-                if e.contains("does not hold") {
-                    e
+            // Errors of the row check and of `each` pass through unchanged; only the reader's
+            // own get the file's name.
+            let mut passed = None;
+            let read = table::read_csv(BufReader::new(file), &self.prep.columns, |row| {
+                let result = if row.run != next || next >= range.end {
+                    Err(wrong())
                 } else {
-                    format!("{d}/runs.csv: {e}")
-                }
-            })?;
+                    next += 1;
+                    each(row)
+                };
+                result.map_err(|e| {
+                    passed = Some(e);
+                    String::new()
+                })
+            });
+            if let Some(e) = passed {
+                return Err(e);
+            }
+            read.map_err(|e| format!("{d}/runs.csv: {e}"))?;
             if next != range.end {
                 return Err(wrong());
             }
         }
         Ok(())
-    };
-    read(&mut |_| Ok(()))?;
-    let mut writer = CampaignWriter::create(out, &prep, None)?;
-    read(&mut |row| writer.push(row))?;
-    let runs = writer.rows();
-    Ok((writer.finish(false, interrupt)?, runs))
+    }
+
+    /// Writes the whole campaign's outputs into `out` (see [`CampaignWriter::finish`] for
+    /// `interrupt`), reading the shards' rows once more. Returns what was written and the
+    /// number of runs.
+    pub fn write(&self, out: &Path, interrupt: &AtomicBool) -> Result<(Written, u64), String> {
+        let mut writer = CampaignWriter::create(out, &self.prep, None)?;
+        self.read_rows(&mut |row| writer.push(row))?;
+        let runs = writer.rows();
+        Ok((writer.finish(false, interrupt)?, runs))
+    }
 }
