@@ -24,9 +24,10 @@
 //! exactly by the continuous equations (tested), whatever the kinematics.
 
 use crate::model::{
-    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum, Validity,
+    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
+    TidalCoupling, Validity,
 };
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Vector3, Vector6};
 use std::fmt::Debug;
 
 /// Largest number of coordinates a particle effector may have.
@@ -86,6 +87,19 @@ pub trait ParticleModel: Debug + Send + Sync {
         u: &[f64],
         out: &mut ParticlePoint,
     );
+    /// The particle sums at coordinates `q`, rates `u` and hub rate `omega` in closed form,
+    /// written into `out` (zeroed on entry), for a model that has one; returns false, and
+    /// `couple` sums [`ParticleModel::particle`] over the particles instead, otherwise. The
+    /// closed form must equal the particle sum to rounding (each model tests it).
+    fn summed<const N: usize>(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _omega: &Vector3<f64>,
+        _out: &mut ParticleSums<N>,
+    ) -> bool {
+        false
+    }
     /// Generalised forces of springs and dashpots, written into `out` (length n).
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]);
     /// Elastic energy (J).
@@ -109,6 +123,44 @@ pub trait ParticleModel: Debug + Send + Sync {
     /// The validity measure at `q` in words ([`Effector::validity_report`]).
     fn validity_report(&self, _q: &[f64]) -> (String, String) {
         (String::new(), String::new())
+    }
+}
+
+/// What `couple` needs from the particles' kinematics, summed over them, for at most `N`
+/// coordinates (only the leading n are used): the module documentation's M, Cᵀ, the
+/// inertial part of g, and the terms of D and e.
+#[derive(Debug, Clone)]
+pub struct ParticleSums<const N: usize> {
+    /// Coordinate mass matrix M = Σ m JᵀJ, lower triangle (kg × coordinate units²).
+    pub mass: [[f64; N]; N],
+    /// Cᵀ = Σ m [Jᵀ, (r × J)ᵀ], one row of 6 per coordinate.
+    pub coupling: [[f64; 6]; N],
+    /// Inertial generalised forces −Σ m Jᵀ c, one per coordinate.
+    pub inertial: [f64; N],
+    /// Σ m (kg).
+    pub total_mass: f64,
+    /// Σ m r (kg m).
+    pub first_moment: Vector3<f64>,
+    /// Σ m (|r|² 1 − r rᵀ) (kg m²).
+    pub inertia: Matrix3<f64>,
+    /// Σ m c (N).
+    pub force: Vector3<f64>,
+    /// Σ m r × c (N m).
+    pub moment: Vector3<f64>,
+}
+
+impl<const N: usize> Default for ParticleSums<N> {
+    fn default() -> Self {
+        ParticleSums {
+            mass: [[0.0; N]; N],
+            coupling: [[0.0; 6]; N],
+            inertial: [0.0; N],
+            total_mass: 0.0,
+            first_moment: Vector3::zeros(),
+            inertia: Matrix3::zeros(),
+            force: Vector3::zeros(),
+            moment: Vector3::zeros(),
+        }
     }
 }
 
@@ -220,66 +272,27 @@ impl<P: ParticleModel> ParticleEffector<P> {
         };
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let w = hub.omega;
-        // M (lower triangle), Cᵀ (n × 6) and g (n).
-        let mut mass = [[0.0; N]; N];
-        let mut ct = [[0.0; 6]; N];
-        let mut g = [0.0; N];
-        let mut d_rr = Matrix3::zeros();
-        let (mut m_sum, mut s_sum) = (0.0, Vector3::zeros());
-        let (mut e_t, mut e_r) = (Vector3::zeros(), Vector3::zeros());
-        let mut pt = ParticlePoint::default();
-        let cache = self.model.prepare(q, u);
-        let mut tidal = coupling.tidal;
-        for p in 0..self.model.num_particles() {
-            self.model.particle(p, &cache, q, u, &mut pt);
-            let m = pt.mass;
-            let r = pt.position;
-            let jac = &pt.jacobian[..n];
-            let mut v_rel = Vector3::zeros();
-            for (k, j) in jac.iter().enumerate() {
-                v_rel += j * u[k];
-            }
-            if let Some(field) = &mut tidal {
-                // The gravity gradient's tidal force on this particle: an external force on
-                // the coordinates (Jᵀ f) and on the system (f, r × f).
-                let f = m * (field.gradient * r);
-                for k in 0..n {
-                    g[k] += jac[k].dot(&f);
-                }
-                let moment = r.cross(&f);
-                for i in 0..3 {
-                    coupling.force[i] += f[i];
-                    coupling.force[3 + i] += moment[i];
-                }
-                let v = w.cross(&r) + v_rel;
-                field.relative_power += f.dot(&v);
-                field.first_moment += m * r;
-                field.relative_momentum += m * v;
-                field.moving_mass += m;
-            }
-            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
-            for k in 0..n {
-                let jk = jac[k];
-                for l in 0..=k {
-                    mass[k][l] += m * jk.dot(&jac[l]);
-                }
-                let rj = r.cross(&jk);
-                let row = &mut ct[k];
-                row[0] += m * jk.x;
-                row[1] += m * jk.y;
-                row[2] += m * jk.z;
-                row[3] += m * rj.x;
-                row[4] += m * rj.y;
-                row[5] += m * rj.z;
-                g[k] -= m * jk.dot(&c);
-            }
-            m_sum += m;
-            s_sum += m * r;
-            d_rr += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
-            e_t += m * c;
-            e_r += m * r.cross(&c);
+        let mut sums = ParticleSums::<N>::default();
+        if coupling.tidal.is_some() || !self.model.summed(q, u, &w, &mut sums) {
+            self.sum_particles(
+                q,
+                u,
+                &w,
+                &mut coupling.tidal,
+                &mut coupling.force,
+                &mut sums,
+            );
         }
-        coupling.tidal = tidal;
+        let ParticleSums {
+            mut mass,
+            coupling: ct,
+            inertial: mut g,
+            total_mass: m_sum,
+            first_moment: s_sum,
+            inertia: d_rr,
+            force: e_t,
+            moment: e_r,
+        } = sums;
         let mut forces = [0.0; MAX_COORDINATES];
         self.model.forces(q, u, &mut forces[..n]);
         for k in 0..n {
@@ -330,6 +343,82 @@ impl<P: ParticleModel> ParticleEffector<P> {
                     coupling.mass[(a, b)] -= cka * yk[1 + b];
                 }
             }
+        }
+    }
+
+    /// The particle sums by summing [`ParticleModel::particle`] over the particles (the
+    /// reference form), with the gravity gradient's tidal forces when `tidal` is given (added
+    /// to the inertial generalised forces and to the hub's `force`).
+    fn sum_particles<const N: usize>(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        w: &Vector3<f64>,
+        tidal: &mut Option<TidalCoupling>,
+        hub_force: &mut Vector6<f64>,
+        sums: &mut ParticleSums<N>,
+    ) {
+        let n = q.len();
+        let ParticleSums {
+            mass,
+            coupling: ct,
+            inertial: g,
+            total_mass: m_sum,
+            first_moment: s_sum,
+            inertia: d_rr,
+            force: e_t,
+            moment: e_r,
+        } = sums;
+        let mut pt = ParticlePoint::default();
+        let cache = self.model.prepare(q, u);
+        for p in 0..self.model.num_particles() {
+            self.model.particle(p, &cache, q, u, &mut pt);
+            let m = pt.mass;
+            let r = pt.position;
+            let jac = &pt.jacobian[..n];
+            let mut v_rel = Vector3::zeros();
+            for (k, j) in jac.iter().enumerate() {
+                v_rel += j * u[k];
+            }
+            if let Some(field) = tidal {
+                // The gravity gradient's tidal force on this particle: an external force on
+                // the coordinates (Jᵀ f) and on the system (f, r × f).
+                let f = m * (field.gradient * r);
+                for k in 0..n {
+                    g[k] += jac[k].dot(&f);
+                }
+                let moment = r.cross(&f);
+                for i in 0..3 {
+                    hub_force[i] += f[i];
+                    hub_force[3 + i] += moment[i];
+                }
+                let v = w.cross(&r) + v_rel;
+                field.relative_power += f.dot(&v);
+                field.first_moment += m * r;
+                field.relative_momentum += m * v;
+                field.moving_mass += m;
+            }
+            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v_rel) + pt.convective;
+            for k in 0..n {
+                let jk = jac[k];
+                for l in 0..=k {
+                    mass[k][l] += m * jk.dot(&jac[l]);
+                }
+                let rj = r.cross(&jk);
+                let row = &mut ct[k];
+                row[0] += m * jk.x;
+                row[1] += m * jk.y;
+                row[2] += m * jk.z;
+                row[3] += m * rj.x;
+                row[4] += m * rj.y;
+                row[5] += m * rj.z;
+                g[k] -= m * jk.dot(&c);
+            }
+            *m_sum += m;
+            *s_sum += m * r;
+            *d_rr += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+            *e_t += m * c;
+            *e_r += m * r.cross(&c);
         }
     }
 }
