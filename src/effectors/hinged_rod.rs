@@ -14,9 +14,9 @@
 //! Gauss–Legendre stations s = L/2 (1 ∓ 1/√3): every term of its equations of motion, its
 //! momentum and its energy is a quadratic polynomial in s, which that rule integrates exactly.
 
-use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::{Drawing, Validity};
-use nalgebra::Vector3;
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use crate::model::{Drawing, Momentum, Validity};
+use nalgebra::{Matrix3, Vector3};
 
 /// Which joint angles are free.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,6 +170,85 @@ impl ParticleModel for HingedRod {
             HingeFreedom::Lag => out.jacobian[0] = s * e_l,
         }
         out.convective = s * kappa;
+    }
+    /// The rod's sums in closed form: with r = h + s ê and the rod's moments about the hinge
+    /// m₁ = ∫ s dm = m L/2 and m₂ = ∫ s² dm = m L²/3 (which the two Gauss particles reproduce
+    /// exactly), the point at s accelerates (relative to the hub) by c(s) = a_h + s a_ê, and
+    /// every sum is a combination of h, ê and its derivatives (docs/effectors.md).
+    fn summed<const N: usize>(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        out: &mut ParticleSums<N>,
+    ) -> bool {
+        let angles = self.angles(q, u);
+        let [e, e_f, e_l, kappa] = self.direction_at(angles);
+        let columns = match self.freedom {
+            HingeFreedom::FlapLag => [e_f, e_l],
+            HingeFreedom::Flap => [e_f, Vector3::zeros()],
+            HingeFreedom::Lag => [e_l, Vector3::zeros()],
+        };
+        let (m, h) = (self.mass, self.hinge);
+        let m1 = 0.5 * m * self.length;
+        let m2 = m * self.length * self.length / 3.0;
+        // Σ m r = m h + m₁ ê and Σ m s r = m₁ h + m₂ ê.
+        let p1 = m * h + m1 * e;
+        let p2 = m1 * h + m2 * e;
+        // a_h = ω × (ω × h), a_ê = ω × (ω × ê) + 2 ω × ê̇ + κ, and ω × (ω × v) = ω (ω·v) − v ω²,
+        // so Σ m c = m a_h + m₁ a_ê and Σ m s c = m₁ a_h + m₂ a_ê are:
+        let w2 = omega.norm_squared();
+        let e_rate = angles[2] * e_f + angles[3] * e_l;
+        let relative = 2.0 * omega.cross(&e_rate) + kappa;
+        let force = omega * omega.dot(&p1) - w2 * p1 + m1 * relative;
+        let force_s = omega * omega.dot(&p2) - w2 * p2 + m2 * relative;
+        for (k, jk) in columns[..q.len()].iter().enumerate() {
+            // ∂ê/∂θ_f ⊥ ∂ê/∂θ_l (c ⊥ c′ and n̂ ⊥ c′): M is diagonal, its off-diagonal
+            // entry exactly zero, which `couple` then eliminates without a factorisation.
+            out.mass[k][k] = m2 * jk.norm_squared();
+            let moment = p2.cross(jk);
+            out.coupling[k] = [
+                m1 * jk.x,
+                m1 * jk.y,
+                m1 * jk.z,
+                moment.x,
+                moment.y,
+                moment.z,
+            ];
+            out.inertial[k] = -jk.dot(&force_s);
+        }
+        out.total_mass = m;
+        out.first_moment = p1;
+        // Σ m (|r|² 1 − r rᵀ) with Σ m r rᵀ = m g gᵀ + (m₂ − m₁²/m) ê êᵀ, g = p1/m (the rod's
+        // centre of mass).
+        let g = p1 / m;
+        let spread = m2 - m1 * m1 / m;
+        out.inertia = Matrix3::from_diagonal_element(m * g.norm_squared() + spread)
+            - m * g * g.transpose()
+            - spread * e * e.transpose();
+        out.force = force;
+        out.moment = h.cross(&force) + e.cross(&force_s);
+        true
+    }
+
+    /// The rod's momentum in closed form: the point at s moves at v(s) = v_h + s v_ê with
+    /// v_h = ω × h and v_ê = ω × ê + ê̇, so every sum is one of m, m₁ and m₂.
+    fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
+        let angles = self.angles(q, u);
+        let [e, e_f, e_l, _] = self.direction_at(angles);
+        let (m, h) = (self.mass, self.hinge);
+        let m1 = 0.5 * m * self.length;
+        let m2 = m * self.length * self.length / 3.0;
+        let v_h = omega.cross(&h);
+        let v_e = omega.cross(&e) + angles[2] * e_f + angles[3] * e_l;
+        Some(Momentum {
+            mass: m,
+            first_moment: m * h + m1 * e,
+            linear: m * v_h + m1 * v_e,
+            angular: m * h.cross(&v_h) + m1 * (h.cross(&v_e) + e.cross(&v_h)) + m2 * e.cross(&v_e),
+            kinetic_energy: 0.5 * (m * v_h.norm_squared() + 2.0 * m1 * v_h.dot(&v_e))
+                + 0.5 * m2 * v_e.norm_squared(),
+        })
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {
         let [f, l, df, dl] = self.angles(q, u);

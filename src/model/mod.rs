@@ -42,6 +42,8 @@ pub const HUB_STATES: usize = 7;
 #[derive(Debug, Clone, PartialEq)]
 pub struct HubCoupling {
     /// Generalised mass (kg, kg m, kg m²): translation rows/columns first, then rotation.
+    /// Symmetric: an effector may add to its lower triangle only, and the spacecraft copies
+    /// that to the upper one once every effector has coupled.
     pub mass: Matrix6<f64>,
     /// Generalised force (N; N m): starts as `[0; −ω × (I ω)]`.
     pub force: Vector6<f64>,
@@ -675,6 +677,12 @@ impl Spacecraft {
                 &mut coupling,
                 &mut scratch[s..s + self.scratch_lens[k]],
             );
+        }
+        // Effectors may add to the lower triangle only (the mass matrix is symmetric).
+        for i in 0..6 {
+            for j in 0..i {
+                coupling.mass[(j, i)] = coupling.mass[(i, j)];
+            }
         }
         coupling
     }

@@ -37,6 +37,20 @@ pub struct Observation {
 }
 
 impl Observation {
+    /// The conserved quantities it holds (what [`Spacecraft::invariants`] computes alone).
+    pub fn invariants(&self) -> Invariants {
+        Invariants {
+            h_body: self.h_body,
+            h_inertial: self.h_inertial,
+            kinetic_energy: self.kinetic_energy,
+            elastic_energy: self.elastic_energy,
+            dissipated_energy: self.dissipated_energy,
+            dissipation_power: self.dissipation_power,
+            external_work: self.external_work,
+            q_norm_error: self.q_norm_error,
+        }
+    }
+
     /// Kinetic + elastic + dissipated energy minus the work of external torques (J):
     /// constant for any spacecraft without a prescribed motion (work–energy theorem).
     pub fn energy_balance(&self) -> f64 {

@@ -507,7 +507,18 @@ fn drive<M: Stepper>(
             last_good = Some(t_good);
             break;
         }
-        inv.update(&mut drift, &sc.invariants(t1, stepper.y()));
+        // The full observation (angles) only when events need it; the drift check reads
+        // its invariants then, and computes them alone otherwise.
+        let o1 = if watches.is_empty() {
+            None
+        } else {
+            Some(sc.observe(t1, stepper.y()))
+        };
+        let step_invariants = match &o1 {
+            Some(o) => o.invariants(),
+            None => sc.invariants(t1, stepper.y()),
+        };
+        inv.update(&mut drift, &step_invariants);
         if passive && drift.energy_rel > DIVERGENCE_ENERGY_REL {
             let what = format!(
                 "the energy balance (kinetic + elastic + dissipated) changed by {:.0}% by \
@@ -572,13 +583,6 @@ fn drive<M: Stepper>(
             status = Some(s);
             break;
         }
-        // The full observation (angles) only when events need it.
-        let o1 = if watches.is_empty() {
-            None
-        } else {
-            Some(sc.observe(t1, stepper.y()))
-        };
-
         // Events inside (t0, t1]: check interior points too, so that a quantity that crosses
         // and re-crosses within one long step is not missed.
         // (event time, time known, condition, terminal)
