@@ -315,14 +315,14 @@ fn bench_wheel_rhs(repeats: usize) {
 }
 
 /// The orbit angle's sine and cosine, the largest single part of the gravity gradient in a
-/// circular orbit: the table-driven `polhode::orbit::sincos` against the C library's, at
+/// circular orbit: the table-driven `polhode::sincos` against the C library's, at
 /// the angles a LEO orbit reaches in a day.
 fn bench_sin_cos(repeats: usize) {
     let calls = 100_000;
     let angle = |k: usize| black_box(0.3 + k as f64 * 1.1e-3 * 0.37);
     let mut table = || {
         for k in 0..calls {
-            black_box(polhode::orbit::sincos::sin_cos(angle(k)));
+            black_box(polhode::sincos::sin_cos(angle(k)));
         }
     };
     let mut library = || {

@@ -129,4 +129,5 @@ pub mod orbit;
 pub mod plot;
 pub mod scenario;
 pub mod sim;
+pub mod sincos;
 pub mod timefmt;

@@ -16,6 +16,7 @@
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
 use crate::model::{Drawing, Momentum, Validity};
+use crate::sincos::sin_cos;
 use nalgebra::{Matrix3, Vector3};
 
 /// Which joint angles are free.
@@ -64,8 +65,8 @@ impl HingedRod {
     fn direction_at(&self, a: [f64; 4]) -> [Vector3<f64>; 4] {
         let [f, l, df, dl] = a;
         let b = self.axis.cross(&self.direction);
-        let (sf, cf) = f.sin_cos();
-        let (sl, cl) = l.sin_cos();
+        let (sf, cf) = sin_cos(f);
+        let (sl, cl) = sin_cos(l);
         let c = cl * self.direction + sl * b;
         let c_prime = -sl * self.direction + cl * b;
         let e = cf * c + sf * self.axis;

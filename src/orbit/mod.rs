@@ -28,7 +28,6 @@ mod earth;
 mod elements;
 pub mod kepler;
 pub mod magnetic;
-pub mod sincos;
 
 pub use body::CentralBody;
 pub use earth::{earth_rotation_angle, gmst_iau82};
@@ -233,7 +232,7 @@ impl Orbit {
         let m = self.mean_anomaly(t);
         let (sin_e, cos_e) = if e == 0.0 {
             // Circular: E = M, no Kepler solve; the table-driven sin/cos (a few ulps).
-            sincos::sin_cos(m)
+            crate::sincos::sin_cos(m)
         } else {
             let s = kepler::solve(m, e);
             (s.sin_e, s.cos_e)
@@ -269,7 +268,7 @@ impl Orbit {
     pub fn direction(&self, t: f64) -> (Vector3<f64>, f64) {
         if self.elements.eccentricity == 0.0 && !self.j2_secular {
             // Circular with fixed axes: a (P̂ cos M + Q̂ sin M), nothing else to form.
-            let (sin_m, cos_m) = sincos::sin_cos(self.mean_anomaly(t));
+            let (sin_m, cos_m) = crate::sincos::sin_cos(self.mean_anomaly(t));
             let [p, q, _] = &self.axes0;
             return (p * cos_m + q * sin_m, self.elements.semi_major_axis);
         }

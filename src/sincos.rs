@@ -1,6 +1,6 @@
-//! `sin x` and `cos x` together for the orbit angle of a circular orbit, cheaper than the C
-//! library's `sincos` (which handles every `f64` and rounds correctly in nearly all cases),
-//! within one unit in the last place of it.
+//! `sin x` and `cos x` together (the orbit angle of a circular orbit, a hinged rod's joint
+//! angles), cheaper than the C library's `sincos` (which handles every `f64` and rounds
+//! correctly in nearly all cases), within one unit in the last place of it.
 //!
 //! Method (the table-driven scheme of P. T. P. Tang, "Table-driven implementation of the
 //! exponential function in IEEE floating-point arithmetic", ACM TOMS 15(2), 1989, applied to
