@@ -3,13 +3,15 @@
 //!
 //!   cargo bench --bench core            # full
 //!   cargo bench --bench core -- --quick # fewer repeats
+//!   cargo bench --bench core -- --effectors  # the effector scenes' right-hand sides only
 //!
 //! 1. One RK4 step of the torque-free body through polhode's `Rk4` stepper and `Spacecraft`
 //!    system, against a minimal hand-written RK4 loop on `[f64; 7]` with the same equations.
 //! 2. A run that logs MCAP at 100 Hz against the same run without logging, on a cheap
 //!    adaptive scene (integration much cheaper than a sample) and a fixed-step one.
 //! 3. The cost of one right-hand-side evaluation of each shipped scene with effectors,
-//!    against the rigid body's (a scene pays only for the effects it includes).
+//!    against the rigid body's (a scene pays only for the effects it includes), and the
+//!    spring–mass damper's against its hand-written reduced form (one 3 × 3 solve).
 //!
 //! Each measurement is the minimum over repeats, and the two sides alternate so that both see
 //! the same machine load.
@@ -169,6 +171,170 @@ fn bench_effector_rhs(repeats: usize) {
             ns / base_ns
         );
     }
+}
+
+/// The nutation-damper scene's right-hand side in its reduced form, written by hand: the hub
+/// (mass M, principal inertia I) and one particle (mass m) on the body line r = r₀ + ρ p̂ with
+/// spring k and dashpot c. With the system's centre of mass fixed, the hub's translation is
+/// eliminated by the reduced mass m* = m M/(M + m); eliminating ρ̈ too leaves one 3 × 3 solve,
+///
+/// ```text
+/// (I + m* (|r|² 1 − r rᵀ − t tᵀ)) ω̇ = −ω × Iω − r × (p̂ Q + m* (c − p̂ (p̂·c))),
+/// ρ̈ = Q/m* − p̂·(ω̇ × r) − p̂·c,
+/// ```
+///
+/// with t = r × p̂, c = ω × (ω × r) + 2ρ̇ ω × p̂ and Q = −kρ − cρ̇. States as polhode's:
+/// [ω, q, ρ, ρ̇, dissipated energy].
+struct ReducedDamper {
+    hub_mass: f64,
+    inertia: [f64; 3],
+    mass: f64,
+    anchor: [f64; 3],
+    direction: [f64; 3],
+    stiffness: f64,
+    damping: f64,
+}
+
+impl ReducedDamper {
+    /// The parameters of scenarios/nutation-damper.yaml.
+    fn nutation_damper() -> Self {
+        ReducedDamper {
+            hub_mass: 5274.4,
+            inertia: [1375.7, 1292.5, 1402.4],
+            mass: 52.744,
+            anchor: [1.0, 0.0, 0.0],
+            direction: [0.0, 0.0, 1.0],
+            stiffness: 52.744,
+            damping: 105.49,
+        }
+    }
+
+    #[inline(always)]
+    fn rhs(&self, y: &[f64; 10], dy: &mut [f64; 10]) {
+        fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        }
+        fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+            a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+        }
+        let w = [y[0], y[1], y[2]];
+        let (rho, rho_dot) = (y[7], y[8]);
+        let (i, p) = (self.inertia, self.direction);
+        let m_star = self.mass * self.hub_mass / (self.hub_mass + self.mass);
+        let r = std::array::from_fn::<f64, 3, _>(|k| self.anchor[k] + rho * p[k]);
+        let w_r = cross(w, r);
+        let w_p = cross(w, p);
+        let ww_r = cross(w, w_r);
+        let c = std::array::from_fn::<f64, 3, _>(|k| ww_r[k] + 2.0 * rho_dot * w_p[k]);
+        let q_force = -self.stiffness * rho - self.damping * rho_dot;
+        let pc = dot(p, c);
+        let pull =
+            std::array::from_fn::<f64, 3, _>(|k| p[k] * q_force + m_star * (c[k] - p[k] * pc));
+        let iw = [i[0] * w[0], i[1] * w[1], i[2] * w[2]];
+        let gyro = cross(w, iw);
+        let r_pull = cross(r, pull);
+        let b = std::array::from_fn::<f64, 3, _>(|k| -gyro[k] - r_pull[k]);
+        let t = cross(r, p);
+        let r2 = dot(r, r);
+        let a = |j: usize, k: usize| {
+            let diagonal = if j == k { i[j] + m_star * r2 } else { 0.0 };
+            diagonal - m_star * (r[j] * r[k] + t[j] * t[k])
+        };
+        // The symmetric 3 × 3 solve by cofactors.
+        let (a00, a01, a02, a11, a12, a22) = (a(0, 0), a(0, 1), a(0, 2), a(1, 1), a(1, 2), a(2, 2));
+        let c00 = a11 * a22 - a12 * a12;
+        let c01 = a02 * a12 - a01 * a22;
+        let c02 = a01 * a12 - a02 * a11;
+        let c11 = a00 * a22 - a02 * a02;
+        let c12 = a01 * a02 - a00 * a12;
+        let c22 = a00 * a11 - a01 * a01;
+        let inv_det = 1.0 / (a00 * c00 + a01 * c01 + a02 * c02);
+        let w_dot = [
+            (c00 * b[0] + c01 * b[1] + c02 * b[2]) * inv_det,
+            (c01 * b[0] + c11 * b[1] + c12 * b[2]) * inv_det,
+            (c02 * b[0] + c12 * b[1] + c22 * b[2]) * inv_det,
+        ];
+        let rho_ddot = q_force / m_star - dot(p, cross(w_dot, r)) - pc;
+        let (qw, qx, qy, qz) = (y[3], y[4], y[5], y[6]);
+        *dy = [
+            w_dot[0],
+            w_dot[1],
+            w_dot[2],
+            -0.5 * (qx * w[0] + qy * w[1] + qz * w[2]),
+            0.5 * (qw * w[0] + qy * w[2] - qz * w[1]),
+            0.5 * (qw * w[1] + qz * w[0] - qx * w[2]),
+            0.5 * (qw * w[2] + qx * w[1] - qy * w[0]),
+            rho_dot,
+            rho_ddot,
+            self.damping * rho_dot * rho_dot,
+        ];
+    }
+}
+
+/// polhode's right-hand side of the nutation-damper scene against [`ReducedDamper`] at the
+/// same state (after checking that they agree).
+fn bench_reduced_damper(repeats: usize) {
+    use polhode::integrate::OdeSystem;
+    let s = scenario::load(
+        Path::new("scenarios/nutation-damper.yaml"),
+        &Overrides::default(),
+    )
+    .expect("scenario");
+    let sc = &s.spacecraft;
+    let mut y = sc.initial_state(&s.omega0, &s.attitude0);
+    // Off the rest point, so that every term is at work.
+    y[7] = 0.05;
+    y[8] = -0.2;
+    let y: [f64; 10] = y.try_into().expect("10 states");
+    let reduced = ReducedDamper::nutation_damper();
+    let (mut ours, mut theirs) = ([0.0; 10], [0.0; 10]);
+    sc.rhs(0.0, &y, &mut ours);
+    reduced.rhs(&y, &mut theirs);
+    for k in 0..10 {
+        let scale = ours[k].abs().max(1e-9);
+        assert!(
+            (ours[k] - theirs[k]).abs() <= 1e-10 * scale,
+            "the reduced form disagrees at state {k}: {} against {}",
+            theirs[k],
+            ours[k]
+        );
+    }
+    let calls = 100_000;
+    let (mut best_reduced, mut best_ours) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        best_reduced = best_reduced.min(min_time(1, || {
+            let mut dy = [0.0; 10];
+            for k in 0..calls {
+                let mut state = y;
+                state[8] += black_box(k as f64 * 1e-9);
+                reduced.rhs(black_box(&state), &mut dy);
+                black_box(&dy);
+            }
+        }));
+        best_ours = best_ours.min(min_time(1, || {
+            let mut dy = [0.0; 10];
+            for k in 0..calls {
+                let mut state = y;
+                state[8] += black_box(k as f64 * 1e-9);
+                sc.rhs(0.0, black_box(&state), &mut dy);
+                black_box(&dy);
+            }
+        }));
+    }
+    let (ns_reduced, ns_ours) = (
+        best_reduced / calls as f64 * 1e9,
+        best_ours / calls as f64 * 1e9,
+    );
+    println!(
+        "\nspring–mass damper (nutation-damper), one right-hand side against the hand-written \
+         reduced form (one 3 × 3 solve):\n  polhode {ns_ours:.1} ns, reduced form {ns_reduced:.1} ns, \
+         ratio {:.2}",
+        ns_ours / ns_reduced
+    );
 }
 
 /// `calls` right-hand-side evaluations of `s` at its initial state, at times spread by
@@ -389,6 +555,12 @@ fn bench_drag_rhs(repeats: usize) {
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 15 };
+    // `--effectors`: the effector scenes' right-hand sides alone.
+    if std::env::args().any(|a| a == "--effectors") {
+        bench_effector_rhs(repeats);
+        bench_reduced_damper(repeats);
+        return;
+    }
     bench_environment_rhs(repeats);
     bench_sin_cos(repeats);
     bench_drag_rhs(repeats);
@@ -397,6 +569,7 @@ fn main() {
         return;
     }
     bench_effector_rhs(repeats);
+    bench_reduced_damper(repeats);
     bench_wheel_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(

@@ -760,6 +760,25 @@ mod tests {
         }
     }
 
+    #[test]
+    fn spring_mass_closed_form_sums_equal_its_particle_sums() {
+        use super::super::spring_mass::SpringMass;
+        let damper = SpringMass {
+            mass: 52.7,
+            position: Vector3::new(1.0, -0.3, 0.2),
+            direction: Vector3::new(0.6, 0.0, 0.8),
+            stiffness: 52.7,
+            damping: 105.5,
+            travel: None,
+        };
+        let e = ParticleEffector::new("damper", damper, &[0.0], &[0.0]);
+        for k in 0..25 {
+            let a = k as f64;
+            let x = [0.4 * (0.7 * a).sin(), 3.0 * (1.3 * a + 0.2).cos()];
+            closed_form_equals_particle_sums(&e, &x);
+        }
+    }
+
     /// The fixed-size coupling (one or two coordinates) and the general one give the same
     /// bits: the same arithmetic, in the same order.
     #[test]

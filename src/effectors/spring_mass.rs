@@ -5,9 +5,9 @@
 //! centre of mass stays put), so no reduced-mass shortcut is taken: any number of these
 //! couple correctly through the hub.
 
-use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::{Drawing, Validity};
-use nalgebra::Vector3;
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use crate::model::{Drawing, Momentum, Validity};
+use nalgebra::{Matrix3, Vector3};
 
 /// A spring–mass–dashpot damper.
 #[derive(Debug, Clone)]
@@ -55,6 +55,42 @@ impl ParticleModel for SpringMass {
         out.position = self.position + q[0] * self.direction;
         out.jacobian[0] = self.direction;
         out.convective = Vector3::zeros();
+    }
+    /// One particle, J = p̂ and no convective term: the sums written out, without the
+    /// general routine's particle record.
+    fn summed<const N: usize>(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        out: &mut ParticleSums<N>,
+    ) -> bool {
+        let (m, p) = (self.mass, self.direction);
+        let r = self.position + q[0] * p;
+        let c = omega.cross(&omega.cross(&r)) + 2.0 * u[0] * omega.cross(&p);
+        let mp = m * p;
+        let moment = r.cross(&mp);
+        out.mass[0][0] = m * p.norm_squared();
+        out.coupling[0] = [mp.x, mp.y, mp.z, moment.x, moment.y, moment.z];
+        out.inertial[0] = -mp.dot(&c);
+        out.total_mass = m;
+        out.first_moment = m * r;
+        out.inertia = m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+        out.force = m * c;
+        out.moment = r.cross(&out.force);
+        true
+    }
+    fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
+        let m = self.mass;
+        let r = self.position + q[0] * self.direction;
+        let v = omega.cross(&r) + u[0] * self.direction;
+        Some(Momentum {
+            mass: m,
+            first_moment: m * r,
+            linear: m * v,
+            angular: m * r.cross(&v),
+            kinetic_energy: 0.5 * m * v.norm_squared(),
+        })
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {
         out[0] = -self.stiffness * q[0] - self.damping * u[0];

@@ -491,9 +491,14 @@ impl Prepared {
             let block = start..(start + BLOCK_RUNS).min(range.end);
             start = block.end;
             let results: Vec<Option<Row>> = pool.install(|| {
-                block
+                // One run per task (rayon would otherwise hand each thread a contiguous chunk
+                // of runs, and a long run late in one chunk leaves the other thread idle):
+                // a thread that runs out steals the next single run.
+                (0..(block.end - block.start) as usize)
                     .into_par_iter()
-                    .map(|i| {
+                    .with_max_len(1)
+                    .map(|j| {
+                        let i = block.start + j as u64;
                         if interrupt.load(Ordering::Relaxed) {
                             return None;
                         }
