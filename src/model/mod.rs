@@ -818,30 +818,34 @@ impl Spacecraft {
     }
 }
 
-/// Solves `m z = f` for a symmetric positive definite 6×6 `m` (lower triangle read) by
-/// Cholesky, with fixed-size loops the compiler unrolls: nalgebra's generic decomposition was
-/// a quarter of a one-damper scene's right-hand side (measured with perf). `None` when `m` is
-/// not positive definite.
+/// Solves `m z = f` for a symmetric positive definite 6×6 `m` (lower triangle read) by its
+/// L D Lᵀ factorisation (L unit lower triangular, D diagonal): no square roots, and one
+/// reciprocal per row, with fixed-size loops the compiler unrolls (nalgebra's generic
+/// decomposition was a quarter of a one-damper scene's right-hand side, measured with perf).
+/// `None` when `m` is not positive definite.
 #[inline]
 #[allow(clippy::needless_range_loop)] // index arithmetic mirrors the textbook algorithm
-fn cholesky_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
+fn ldlt_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
+    // l[i][k] (i > k) is L's entry; ld[i][k] = l[i][k] d_k; inv_d[j] = 1/d_j.
     let mut l = [[0.0f64; 6]; 6];
+    let mut ld = [[0.0f64; 6]; 6];
+    let mut inv_d = [0.0f64; 6];
     for j in 0..6 {
         let mut d = m[(j, j)];
         for k in 0..j {
-            d -= l[j][k] * l[j][k];
+            d -= l[j][k] * ld[j][k];
         }
         if d.is_nan() || d <= 0.0 {
             return None;
         }
-        let d = d.sqrt();
-        l[j][j] = d;
+        inv_d[j] = 1.0 / d;
         for i in j + 1..6 {
             let mut s = m[(i, j)];
             for k in 0..j {
-                s -= l[i][k] * l[j][k];
+                s -= ld[i][k] * l[j][k];
             }
-            l[i][j] = s / d;
+            ld[i][j] = s;
+            l[i][j] = s * inv_d[j];
         }
     }
     let mut z = [0.0f64; 6];
@@ -850,14 +854,17 @@ fn cholesky_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
         for k in 0..i {
             s -= l[i][k] * z[k];
         }
-        z[i] = s / l[i][i];
+        z[i] = s;
+    }
+    for i in 0..6 {
+        z[i] *= inv_d[i];
     }
     for i in (0..6).rev() {
         let mut s = z[i];
         for k in i + 1..6 {
             s -= l[k][i] * z[k];
         }
-        z[i] = s / l[i][i];
+        z[i] = s;
     }
     Some(Vector6::from(z))
 }
@@ -866,9 +873,9 @@ fn cholesky_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
 #[inline(always)]
 fn solve_hub(c: &HubCoupling) -> HubAcceleration {
     if c.translation {
-        // The generalised mass is symmetric positive definite: Cholesky (LU if rounding
+        // The generalised mass is symmetric positive definite: L D Lᵀ (LU if rounding
         // spoils definiteness).
-        let solved = match cholesky_solve6(&c.mass, &c.force) {
+        let solved = match ldlt_solve6(&c.mass, &c.force) {
             Some(z) => Some(z),
             None => c.mass.lu().solve(&c.force),
         };
@@ -1022,5 +1029,20 @@ mod tests {
         // Work–energy theorem: the change in T equals the work done by the torque.
         approx::assert_relative_eq!(t1 - t0, y[7], max_relative = 1e-9);
         assert!(y[7].abs() > 1e-3, "the torque must have done work");
+    }
+
+    #[test]
+    fn ldlt_solves_a_positive_definite_system_and_refuses_an_indefinite_one() {
+        // B Bᵀ + 1 is positive definite; only its lower triangle is stored.
+        let b = Matrix6::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * i as f64);
+        let full = b * b.transpose() + Matrix6::identity();
+        let lower = Matrix6::from_fn(|i, j| if i >= j { full[(i, j)] } else { 0.0 });
+        let f = Vector6::new(1.0, -2.0, 0.5, 3.0, -1.5, 0.25);
+        let z = ldlt_solve6(&lower, &f).expect("positive definite");
+        let reference = full.lu().solve(&f).expect("regular");
+        approx::assert_relative_eq!(z, reference, max_relative = 1e-12);
+        let mut indefinite = full;
+        indefinite[(4, 4)] = -1.0;
+        assert!(ldlt_solve6(&indefinite, &f).is_none());
     }
 }
