@@ -56,6 +56,46 @@ impl Default for ParticlePoint {
     }
 }
 
+/// The sums of the particle loop of the coupling, for a model that has them in closed form
+/// ([`ParticleModel::summed`]): everything the loop accumulates, before the springs, the
+/// dashpots and the back-substitution are added. Only the leading n entries (n × n for
+/// `mass`) are read.
+#[derive(Debug, Clone)]
+pub struct ParticleSums<const N: usize> {
+    /// M = Σ m JᵀJ: row k holds columns 0..=k (the lower triangle; kg per unit coordinate²).
+    pub mass: [[f64; N]; N],
+    /// Cᵀ = Σ m [Jᵀ, (r × J)ᵀ]: row k is [Σ m J_k, Σ m r × J_k].
+    pub ct: [[f64; 6]; N],
+    /// −Σ m Jᵀ c (the generalised inertial forces, without the springs and dashpots).
+    pub g: [f64; N],
+    /// Σ m (kg).
+    pub m_sum: f64,
+    /// Σ m r (kg m).
+    pub s_sum: Vector3<f64>,
+    /// Σ m (|r|² 1 − r rᵀ) (kg m²).
+    pub d_rr: Matrix3<f64>,
+    /// Σ m c (N).
+    pub e_t: Vector3<f64>,
+    /// Σ m r × c (N m).
+    pub e_r: Vector3<f64>,
+}
+
+impl<const N: usize> ParticleSums<N> {
+    /// All sums zero.
+    pub fn zero() -> Self {
+        ParticleSums {
+            mass: [[0.0; N]; N],
+            ct: [[0.0; 6]; N],
+            g: [0.0; N],
+            m_sum: 0.0,
+            s_sum: Vector3::zeros(),
+            d_rr: Matrix3::zeros(),
+            e_t: Vector3::zeros(),
+            e_r: Vector3::zeros(),
+        }
+    }
+}
+
 /// A set of particles moved by `n` coordinates, with springs and dashpots on them.
 pub trait ParticleModel: Debug + Send + Sync {
     /// What is shared by all particles at given coordinates and rates (computed once).
@@ -86,6 +126,24 @@ pub trait ParticleModel: Debug + Send + Sync {
         u: &[f64],
         out: &mut ParticlePoint,
     );
+    /// The particle loop's sums at coordinates `q`, rates `u` and hub rate `omega`, in closed
+    /// form, written into `out` (zeroed, with N ≥ n); returns false, leaving the sums to the
+    /// loop over [`ParticleModel::particle`], if the model has no closed form (the default).
+    /// The effector uses it when no gravity gradient acts on the particles.
+    fn summed<const N: usize>(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _omega: &Vector3<f64>,
+        _out: &mut ParticleSums<N>,
+    ) -> bool {
+        false
+    }
+    /// The particles' momentum ([`Effector::momentum`]) at coordinates `q`, rates `u` and hub
+    /// rate `omega`, in closed form; `None` (the default) sums it particle by particle.
+    fn summed_momentum(&self, _q: &[f64], _u: &[f64], _omega: &Vector3<f64>) -> Option<Momentum> {
+        None
+    }
     /// Generalised forces of springs and dashpots, written into `out` (length n).
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]);
     /// Elastic energy (J).
@@ -230,7 +288,27 @@ impl<P: ParticleModel> ParticleEffector<P> {
         let mut pt = ParticlePoint::default();
         let cache = self.model.prepare(q, u);
         let mut tidal = coupling.tidal;
-        for p in 0..self.model.num_particles() {
+        // A model with its sums in closed form skips the loop (unless tidal forces act).
+        let mut sums = ParticleSums::<N>::zero();
+        let summed = tidal.is_none() && self.model.summed(q, u, &w, &mut sums);
+        if summed {
+            ParticleSums {
+                mass,
+                ct,
+                g,
+                m_sum,
+                s_sum,
+                d_rr,
+                e_t,
+                e_r,
+            } = sums;
+        }
+        let particles = if summed {
+            0
+        } else {
+            self.model.num_particles()
+        };
+        for p in 0..particles {
             self.model.particle(p, &cache, q, u, &mut pt);
             let m = pt.mass;
             let r = pt.position;
@@ -376,6 +454,8 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
         match self.model.num_coordinates() {
             1 => self.couple_sized::<1>(hub, x, coupling, scratch),
             2 => self.couple_sized::<2>(hub, x, coupling, scratch),
+            4 => self.couple_sized::<4>(hub, x, coupling, scratch),
+            6 => self.couple_sized::<6>(hub, x, coupling, scratch),
             _ => self.couple_sized::<MAX_COORDINATES>(hub, x, coupling, scratch),
         }
     }
@@ -407,6 +487,9 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
     fn momentum(&self, hub: &HubState, x: &[f64]) -> Momentum {
         let n = self.model.num_coordinates();
         let (q, u) = (&x[..n], &x[n..2 * n]);
+        if let Some(summed) = self.model.summed_momentum(q, u, &hub.omega) {
+            return summed;
+        }
         let mut out = Momentum::default();
         let mut pt = ParticlePoint::default();
         let cache = self.model.prepare(q, u);
@@ -501,7 +584,7 @@ mod tests {
         assert!(!cholesky(&mut singular, 2));
     }
 
-    /// The fixed-size coupling (one or two coordinates) and the general one give the same
+    /// The fixed-size coupling (one, two, four or six coordinates) and the general one give the same
     /// bits: the same arithmetic, in the same order.
     #[test]
     fn fixed_size_coupling_equals_the_general_one_bit_for_bit() {
@@ -525,7 +608,9 @@ mod tests {
             let (mut s1, mut s2) = (vec![0.0; 7 * n], vec![0.0; 7 * n]);
             match n {
                 1 => e.couple_sized::<1>(&hub, x, &mut fixed, &mut s1),
-                _ => e.couple_sized::<2>(&hub, x, &mut fixed, &mut s1),
+                2 => e.couple_sized::<2>(&hub, x, &mut fixed, &mut s1),
+                4 => e.couple_sized::<4>(&hub, x, &mut fixed, &mut s1),
+                _ => e.couple_sized::<6>(&hub, x, &mut fixed, &mut s1),
             }
             e.couple_sized::<MAX_COORDINATES>(&hub, x, &mut general, &mut s2);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -561,5 +646,32 @@ mod tests {
         };
         let e = ParticleEffector::new("damper", damper, &[0.01], &[0.3]);
         both(&e, &[0.01, 0.3, 0.0]);
+        // Modal beams of two and three modes in two directions, by their shape integrals.
+        use super::super::beam::{BeamProperties, beam_modes};
+        use super::super::modal::ModalBeam;
+        for modes in [2, 3] {
+            let shapes = beam_modes(
+                &BeamProperties {
+                    length: 1.5,
+                    bending_stiffness: 4.0,
+                    mass_per_length: 0.3,
+                    tip_mass: 0.1,
+                },
+                modes,
+            )
+            .unwrap();
+            let beam = ModalBeam::new(
+                shapes,
+                Vector3::new(0.2, 0.0, 0.1),
+                Vector3::x(),
+                vec![("flap".into(), Vector3::z()), ("lag".into(), -Vector3::y())],
+                0.01,
+                true,
+            );
+            let n = 2 * modes;
+            let x: Vec<f64> = (0..=2 * n).map(|k| 0.01 * (k as f64 - 3.3)).collect();
+            let e = ParticleEffector::new("beam", beam, &x[..n], &x[n..2 * n]);
+            both(&e, &x);
+        }
     }
 }
