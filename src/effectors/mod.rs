@@ -27,6 +27,7 @@ pub mod hinged_rod;
 pub mod magnetic_dipole;
 pub mod magnetorquer;
 pub mod modal;
+mod modal_integrals;
 pub mod motion;
 pub mod motor;
 pub mod motor_wheel;

@@ -15,16 +15,23 @@
 //! model) a beam spun above its first frequency diverges. The modes and the mass nodes come
 //! from [`super::beam`] (Rayleigh–Ritz, tip mass included); the beam is that set of mass nodes,
 //! so the particle formulation applies exactly. Modal damping: Q = −ω_i² q − 2ζ ω_i q̇.
+//!
+//! The coupling does not sum over the nodes at each right-hand side: every sum is a
+//! contraction of state-dependent coefficients with the node sums Σm, Σm x, Σm φ_i, …,
+//! Σm S_ij S_kl (the shape integrals), taken once by [`ModalBeam::new`]; the node loop
+//! remains for the gravity gradient's tidal forces (equations in `docs/effectors.md`).
 
 use super::beam::BeamModes;
-use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::{Drawing, Validity};
+use super::modal_integrals::{Geometry, ShapeIntegrals};
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use crate::model::{Drawing, Momentum, Validity};
 use nalgebra::Vector3;
 
 /// A modal cantilever beam.
 #[derive(Debug, Clone)]
 pub struct ModalBeam {
-    /// Modes and mass nodes.
+    /// Modes and mass nodes. The coupling sums them once, at [`ModalBeam::new`] (the shape
+    /// integrals): change them by making a new beam.
     pub modes: BeamModes,
     /// Root point p₀ (m, body axes, about the hub's centre of mass).
     pub attachment: Vector3<f64>,
@@ -38,6 +45,8 @@ pub struct ModalBeam {
     pub geometric_stiffening: bool,
     /// Nodes that carry mass (indices into `modes.nodes`).
     massive: Vec<usize>,
+    /// The node sums of the mass model (`None`: the coupling sums node by node).
+    integrals: Option<ShapeIntegrals>,
 }
 
 impl ModalBeam {
@@ -53,7 +62,9 @@ impl ModalBeam {
         let massive = (0..modes.nodes.len())
             .filter(|&g| modes.nodes[g].mass > 0.0)
             .collect();
+        let integrals = ShapeIntegrals::new(&modes);
         ModalBeam {
+            integrals,
             modes,
             attachment,
             axis,
@@ -82,6 +93,28 @@ impl ModalBeam {
             }
         }
         r
+    }
+
+    /// The bending directions as an array (`None` past two).
+    fn directions(&self) -> Option<([Vector3<f64>; 2], usize)> {
+        let mut directions = [Vector3::zeros(); 2];
+        if self.bending.len() > directions.len() {
+            return None;
+        }
+        for (d, (_, t)) in self.bending.iter().enumerate() {
+            directions[d] = *t;
+        }
+        Some((directions, self.bending.len()))
+    }
+
+    /// The geometry the shape integrals are contracted with.
+    fn geometry<'a>(&self, directions: &'a ([Vector3<f64>; 2], usize)) -> Geometry<'a> {
+        Geometry {
+            attachment: self.attachment,
+            axis: self.axis,
+            directions: &directions.0[..directions.1],
+            stiffening: self.geometric_stiffening,
+        }
     }
 
     /// Tip deflection along each bending direction (m).
@@ -196,6 +229,25 @@ impl ParticleModel for ModalBeam {
         }
         out.position = r;
         out.convective = -kappa * self.axis;
+    }
+    fn summed<const N: usize>(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        out: &mut ParticleSums<N>,
+    ) -> bool {
+        let (Some(integrals), Some(directions)) = (&self.integrals, self.directions()) else {
+            return false;
+        };
+        integrals.sums(&self.geometry(&directions), q, u, omega, out);
+        true
+    }
+    fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
+        let integrals = self.integrals.as_ref()?;
+        let directions = self.directions()?;
+        let geometry = self.geometry(&directions);
+        Some(integrals.momentum(&geometry, q, u, omega))
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {
         let n = self.n_modes();

@@ -523,6 +523,8 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
         match self.model.num_coordinates() {
             1 => self.couple_sized::<1>(hub, x, coupling, scratch),
             2 => self.couple_sized::<2>(hub, x, coupling, scratch),
+            4 => self.couple_sized::<4>(hub, x, coupling, scratch),
+            6 => self.couple_sized::<6>(hub, x, coupling, scratch),
             _ => self.couple_sized::<MAX_COORDINATES>(hub, x, coupling, scratch),
         }
     }
@@ -779,7 +781,8 @@ mod tests {
         }
     }
 
-    /// The fixed-size coupling (one or two coordinates) and the general one give the same
+    /// The fixed-size coupling (one, two, four or six coordinates) and the general one give
+    /// the same
     /// bits: the same arithmetic, in the same order.
     #[test]
     fn fixed_size_coupling_equals_the_general_one_bit_for_bit() {
@@ -803,7 +806,9 @@ mod tests {
             let (mut s1, mut s2) = (vec![0.0; e.scratch_len()], vec![0.0; e.scratch_len()]);
             match n {
                 1 => e.couple_sized::<1>(&hub, x, &mut fixed, &mut s1),
-                _ => e.couple_sized::<2>(&hub, x, &mut fixed, &mut s1),
+                2 => e.couple_sized::<2>(&hub, x, &mut fixed, &mut s1),
+                4 => e.couple_sized::<4>(&hub, x, &mut fixed, &mut s1),
+                _ => e.couple_sized::<6>(&hub, x, &mut fixed, &mut s1),
             }
             e.couple_sized::<MAX_COORDINATES>(&hub, x, &mut general, &mut s2);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -839,5 +844,32 @@ mod tests {
         };
         let e = ParticleEffector::new("damper", damper, &[0.01], &[0.3]);
         both(&e, &[0.01, 0.3, 0.0]);
+        // Modal beams of two and three modes in two directions, by their shape integrals.
+        use super::super::beam::{BeamProperties, beam_modes};
+        use super::super::modal::ModalBeam;
+        for modes in [2, 3] {
+            let shapes = beam_modes(
+                &BeamProperties {
+                    length: 1.5,
+                    bending_stiffness: 4.0,
+                    mass_per_length: 0.3,
+                    tip_mass: 0.1,
+                },
+                modes,
+            )
+            .unwrap();
+            let beam = ModalBeam::new(
+                shapes,
+                Vector3::new(0.2, 0.0, 0.1),
+                Vector3::x(),
+                vec![("flap".into(), Vector3::z()), ("lag".into(), -Vector3::y())],
+                0.01,
+                true,
+            );
+            let n = 2 * modes;
+            let x: Vec<f64> = (0..=2 * n).map(|k| 0.01 * (k as f64 - 3.3)).collect();
+            let e = ParticleEffector::new("beam", beam, &x[..n], &x[n..2 * n]);
+            both(&e, &x);
+        }
     }
 }
