@@ -405,65 +405,33 @@ fn copy_sums<const C: usize, const N: usize>(
 mod tests {
     use super::super::beam::{BeamProperties, beam_modes};
     use super::super::modal::ModalBeam;
-    use super::super::particles::{MAX_COORDINATES, ParticleModel, ParticlePoint, ParticleSums};
+    use super::super::particles::{MAX_COORDINATES, ParticleEffector, ParticleModel, ParticleSums};
     use super::*;
+    use crate::model::{Effector, HubState};
 
-    /// The sums by the particle loop, node by node (the reference).
+    /// The sums by the particle effector's own loop, node by node (the reference).
     fn node_sums(
         beam: &ModalBeam,
         q: &[f64],
         u: &[f64],
         w: &Vector3<f64>,
     ) -> ParticleSums<MAX_COORDINATES> {
-        let n = beam.num_coordinates();
-        let mut s = ParticleSums::default();
-        let mut pt = ParticlePoint::default();
-        for p in 0..beam.num_particles() {
-            beam.particle(p, &(), q, u, &mut pt);
-            let (m, r, jac) = (pt.mass, pt.position, &pt.jacobian[..n]);
-            let v: Vector3<f64> = jac.iter().zip(u).map(|(j, uk)| j * *uk).sum();
-            let c = w.cross(&w.cross(&r)) + 2.0 * w.cross(&v) + pt.convective;
-            for k in 0..n {
-                for l in 0..=k {
-                    s.mass[k][l] += m * jac[k].dot(&jac[l]);
-                }
-                let rj = r.cross(&jac[k]);
-                for a in 0..3 {
-                    s.coupling[k][a] += m * jac[k][a];
-                    s.coupling[k][3 + a] += m * rj[a];
-                }
-                s.inertial[k] -= m * jac[k].dot(&c);
-            }
-            s.total_mass += m;
-            s.first_moment += m * r;
-            s.inertia += m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
-            s.force += m * c;
-            s.moment += m * r.cross(&c);
-        }
-        s
+        let effector = ParticleEffector::new("beam", beam.clone(), q, u);
+        let mut sums = ParticleSums::default();
+        let mut hub_force = nalgebra::Vector6::zeros();
+        effector.sum_particles(q, u, w, &mut None, &mut hub_force, &mut sums);
+        sums
     }
 
-    /// The momentum by the particle loop, node by node (the reference).
+    /// The momentum by the particle effector's own loop, node by node (the reference).
     fn node_momentum(beam: &ModalBeam, q: &[f64], u: &[f64], w: &Vector3<f64>) -> Momentum {
-        let n = beam.num_coordinates();
-        let mut out = Momentum::default();
-        let mut pt = ParticlePoint::default();
-        for p in 0..beam.num_particles() {
-            beam.particle(p, &(), q, u, &mut pt);
-            let (m, r) = (pt.mass, pt.position);
-            let v = w.cross(&r)
-                + pt.jacobian[..n]
-                    .iter()
-                    .zip(u)
-                    .map(|(j, uk)| j * *uk)
-                    .sum::<Vector3<f64>>();
-            out.mass += m;
-            out.first_moment += m * r;
-            out.linear += m * v;
-            out.angular += m * r.cross(&v);
-            out.kinetic_energy += 0.5 * m * v.norm_squared();
-        }
-        out
+        let effector = ParticleEffector::new("beam", beam.clone(), q, u);
+        let hub = HubState {
+            t: 0.0,
+            omega: *w,
+            attitude: &[1.0, 0.0, 0.0, 0.0],
+        };
+        effector.momentum_of_particles(&hub, &effector.initial_state())
     }
 
     /// A deterministic uniform number in [−1, 1) (xorshift64*).

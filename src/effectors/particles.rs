@@ -381,7 +381,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
     /// The particle sums by summing [`ParticleModel::particle`] over the particles (the
     /// reference form), with the gravity gradient's tidal forces when `tidal` is given (added
     /// to the inertial generalised forces and to the hub's `force`).
-    fn sum_particles<const N: usize>(
+    pub(crate) fn sum_particles<const N: usize>(
         &self,
         q: &[f64],
         u: &[f64],
@@ -455,7 +455,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
     }
 
     /// [`Effector::momentum`] summed over the particles (the reference form).
-    fn momentum_of_particles(&self, hub: &HubState, x: &[f64]) -> Momentum {
+    pub(crate) fn momentum_of_particles(&self, hub: &HubState, x: &[f64]) -> Momentum {
         let n = self.model.num_coordinates();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let mut out = Momentum::default();
