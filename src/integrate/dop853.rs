@@ -20,9 +20,11 @@
 //! Right-hand-side evaluations: 11 per attempted step (stages 2–12), plus 1 for stage 13 at
 //! the new point when the step is accepted (reused as stage 1 of the next step), plus 3 for
 //! the dense-output stages of an accepted step (unless switched off with
-//! [`Dop853::with_dense_output`]); the first step adds 1 for `f(t0, y0)` and, without a given
-//! first step, 1 for the starting-step estimate. So a run costs
-//! `1 [+ 1] + 15·accepted + 11·rejected` evaluations (12 instead of 15 without dense output).
+//! [`Dop853::with_dense_output`], or deferred to the steps that are interpolated with
+//! [`Dop853::with_lazy_dense_output`]); the first step adds 1 for `f(t0, y0)` and, without a
+//! given first step, 1 for the starting-step estimate. So a run costs
+//! `1 [+ 1] + 15·accepted + 11·rejected` evaluations (12 instead of 15 for a step without
+//! dense output).
 
 // The coefficients keep all the digits of the published tables so that they can be checked
 // against the source by eye; the compiler rounds them to the nearest `f64`.
@@ -238,16 +240,29 @@ fn combine<const M: usize>(out: &mut [f64], base: &[f64], h: f64, a: [f64; M], m
     }
 }
 
+/// When [`Dop853`] evaluates the dense-output stages of an accepted step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum DenseOutput {
+    /// Never: interpolation at the step's ends only.
+    Off,
+    /// On every accepted step.
+    Eager,
+    /// When [`Stepper::prepare_interpolation`] asks for them.
+    Lazy,
+}
+
 /// Adaptive Dormand–Prince 8(5,3) ("DOP853", the method of SciPy's `DOP853` and of Hairer's
 /// `dop853.f`): eighth order, for smooth problems at tight tolerances, where it needs far
 /// fewer right-hand-side evaluations than [`super::Dopri5`].
 ///
 /// Integrates forward in time only (`t_end > t`).
 ///
-/// Dense output is computed eagerly on every accepted step (3 extra evaluations, 15 per step
-/// in all). It cannot be lazy: [`Stepper::interpolate`] is given no system to evaluate, and a
-/// stepper cannot keep a borrow of the system between calls. A caller that never interpolates
-/// inside steps can switch it off with [`Dop853::with_dense_output`] (12 per step).
+/// Dense output is computed eagerly on every accepted step by default (3 extra evaluations,
+/// 15 per step in all): [`Stepper::interpolate`] is given no system to evaluate. A caller
+/// that never interpolates inside steps can switch it off with [`Dop853::with_dense_output`]
+/// (12 per step); one that interpolates inside some steps only can defer it with
+/// [`Dop853::with_lazy_dense_output`] and call [`Stepper::prepare_interpolation`] before it
+/// interpolates inside a step (12 per step, 15 for the steps it reads).
 #[derive(Debug, Clone)]
 pub struct Dop853 {
     tol: Tolerances,
@@ -265,7 +280,10 @@ pub struct Dop853 {
     /// Dense-output coefficients of the last accepted step; `cont[0]` is the state at its
     /// start (kept even without dense output).
     cont: [Vec<f64>; 8],
-    dense: bool,
+    dense: DenseOutput,
+    /// Whether `cont` holds the last accepted step's interpolant (the dense stages of a lazy
+    /// stepper are evaluated on demand).
+    dense_ready: bool,
     fac_old: f64,
     first_step: bool,
     stats: Stats,
@@ -288,7 +306,8 @@ impl Dop853 {
             stage: z(),
             k: std::array::from_fn(|_| z()),
             cont: std::array::from_fn(|_| y0.to_vec()),
-            dense: true,
+            dense: DenseOutput::Eager,
+            dense_ready: false,
             fac_old: 1e-4,
             first_step: true,
             stats: Stats::default(),
@@ -300,7 +319,20 @@ impl Dop853 {
     /// callers that only need the states at the step ends; [`Stepper::interpolate`] then
     /// panics for a time strictly inside a step.
     pub fn with_dense_output(mut self, enabled: bool) -> Self {
-        self.dense = enabled;
+        self.dense = if enabled {
+            DenseOutput::Eager
+        } else {
+            DenseOutput::Off
+        };
+        self
+    }
+
+    /// Defers the dense-output stages of each accepted step until
+    /// [`Stepper::prepare_interpolation`] asks for them: a step that is never interpolated
+    /// inside costs 12 evaluations instead of 15. The interpolant is bit-for-bit the eager one
+    /// (the same stages from the same values, which stay in place until the next step).
+    pub fn with_lazy_dense_output(mut self) -> Self {
+        self.dense = DenseOutput::Lazy;
         self
     }
 
@@ -467,9 +499,16 @@ impl Dop853 {
         if !all_finite(&self.k[12]) {
             return false;
         }
-        if !self.dense {
+        if self.dense != DenseOutput::Eager {
             return true;
         }
+        self.dense_stages(sys, h)
+    }
+
+    /// Evaluates the dense-output stages 14–16 of the step `h` from `y` (`k[0]` its first
+    /// stage, `k[12]` f at its end). Returns whether they are finite.
+    fn dense_stages<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> bool {
+        let all_finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
         let (t, y, s, k) = (self.t, &self.y[..], &mut self.stage[..], &mut self.k);
         combine(
             s,
@@ -626,11 +665,12 @@ impl Stepper for Dop853 {
                     h_new = h_new.min(h);
                 }
                 self.fac_old = err.max(1e-4);
-                if self.dense {
+                if self.dense == DenseOutput::Eager {
                     self.store_dense_output(h);
                 } else {
                     self.cont[0].copy_from_slice(&self.y);
                 }
+                self.dense_ready = self.dense == DenseOutput::Eager;
                 std::mem::swap(&mut self.y, &mut self.y_new);
                 // FSAL: stage 13 is f at the new point.
                 self.k.swap(0, 12);
@@ -652,10 +692,33 @@ impl Stepper for Dop853 {
 
     /// Seventh-order interpolant of the last accepted step. Panics for a time strictly inside
     /// the step if dense output was switched off ([`Dop853::with_dense_output`]).
-    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+    fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]) {
+        // The dense output of the step before the breakpoint stays readable.
+        self.prepare_interpolation(sys);
         self.y.copy_from_slice(y);
         // The first-same-as-last stage is recomputed at the next step (the step size is kept).
         self.first_step = true;
+    }
+
+    /// With lazy dense output, evaluates the last step's dense stages if it has not yet; the
+    /// step's values are still in place (the previous state in `y_new`, its first stage in
+    /// `k[12]` and its last in `k[0]`, swapped there by the step's end).
+    fn prepare_interpolation<S: OdeSystem + ?Sized>(&mut self, sys: &S) -> bool {
+        if self.dense_ready || self.dense != DenseOutput::Lazy || self.t == self.t_prev {
+            return true;
+        }
+        let (t, h) = (self.t, self.t - self.t_prev);
+        // Back to the step's start as `dense_stages` and `store_dense_output` read it.
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        self.k.swap(0, 12);
+        self.t = self.t_prev;
+        let finite = self.dense_stages(sys, h);
+        self.store_dense_output(h);
+        std::mem::swap(&mut self.y, &mut self.y_new);
+        self.k.swap(0, 12);
+        self.t = t;
+        self.dense_ready = true;
+        finite
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
@@ -670,8 +733,9 @@ impl Stepper for Dop853 {
             return;
         }
         assert!(
-            self.dense,
-            "Dop853::interpolate inside a step needs dense output, which was switched off"
+            self.dense_ready,
+            "Dop853::interpolate inside a step needs dense output, which was switched off \
+             (or, lazy, not prepared by `prepare_interpolation`)"
         );
         let s = (t - self.t_prev) / h;
         let s1 = 1.0 - s;
@@ -1038,6 +1102,54 @@ mod tests {
                 assert!(st.rejected_steps > 0);
             }
         }
+    }
+
+    #[test]
+    fn lazy_dense_output_is_the_eager_one_where_it_is_asked_for() {
+        // The same steps, and the same interpolant bit for bit on every third step (the only
+        // ones prepared), for 3 evaluations fewer on each of the other steps.
+        let (eager_sys, lazy_sys) = (Counted::new(&Kepler), Counted::new(&Kepler));
+        let y0 = kepler_exact(0.5, 0.0);
+        let mut eager = Dop853::new(0.0, &y0, tol(1e-10), f64::INFINITY, None);
+        let mut lazy =
+            Dop853::new(0.0, &y0, tol(1e-10), f64::INFINITY, None).with_lazy_dense_output();
+        let (mut prepared, mut a, mut b) = (0, [0.0; 4], [0.0; 4]);
+        while eager.t() < 10.0 {
+            eager.step(&eager_sys, 10.0).unwrap();
+            lazy.step(&lazy_sys, 10.0).unwrap();
+            assert_eq!(eager.t(), lazy.t());
+            assert_eq!(eager.y(), lazy.y());
+            if eager.stats().steps.is_multiple_of(3) {
+                assert!(lazy.prepare_interpolation(&lazy_sys));
+                // A second call does nothing.
+                assert!(lazy.prepare_interpolation(&lazy_sys));
+                prepared += 1;
+                for s in [0.1, 0.5, 0.9] {
+                    let t = eager.t_prev() + s * (eager.t() - eager.t_prev());
+                    eager.interpolate(t, &mut a);
+                    lazy.interpolate(t, &mut b);
+                    assert_eq!(a, b, "t = {t}");
+                }
+            }
+        }
+        let (e, l) = (eager.stats(), lazy.stats());
+        assert!(prepared > 10);
+        assert_eq!(e.steps, l.steps);
+        assert_eq!(lazy_sys.calls.get(), l.rhs_evaluations);
+        assert_eq!(
+            e.rhs_evaluations - l.rhs_evaluations,
+            3 * (e.steps - prepared)
+        );
+    }
+
+    #[test]
+    #[should_panic(expected = "prepare_interpolation")]
+    fn interpolating_an_unprepared_lazy_step_panics() {
+        let mut s =
+            Dop853::new(0.0, &[1.0, 0.0], tol(1e-8), f64::INFINITY, None).with_lazy_dense_output();
+        s.step(&Oscillator, 1.0).unwrap();
+        let mut out = [0.0; 2];
+        s.interpolate(0.5 * s.t(), &mut out);
     }
 
     #[test]

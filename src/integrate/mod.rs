@@ -126,8 +126,15 @@ pub trait Stepper {
     fn step<S: OdeSystem + ?Sized>(&mut self, sys: &S, t_end: f64) -> Result<f64, StepError>;
     /// Start time of the last accepted step (equals `t()` before the first step).
     fn t_prev(&self) -> f64;
-    /// Interpolates the state at `t` within the last accepted step `[t_prev, t]`.
+    /// Interpolates the state at `t` within the last accepted step `[t_prev, t]`. A stepper
+    /// with deferred dense output needs [`Stepper::prepare_interpolation`] first for a `t`
+    /// strictly inside the step.
     fn interpolate(&self, t: f64, out: &mut [f64]);
+    /// Completes the last accepted step's dense output if the method defers it (dop853's
+    /// lazy stages); `false` when that work came out non-finite. Cheap when done already.
+    fn prepare_interpolation<S: OdeSystem + ?Sized>(&mut self, _sys: &S) -> bool {
+        true
+    }
     /// Work counters so far.
     fn stats(&self) -> Stats;
     /// Continues from the current time with the state `y` (the integrated one, with held

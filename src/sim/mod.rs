@@ -23,7 +23,7 @@ pub use steppers::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
 use crate::timefmt::seconds;
-use events::Watch;
+use events::{Watch, far_from_crossing};
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -454,6 +454,10 @@ fn drive<M: Stepper>(
     let mut last_obs = o0.clone();
     // Event-check points of the current step: (time, observation).
     let mut grid: Vec<(f64, Observation)> = Vec::with_capacity(interior_checks + 2);
+    // Each condition's margin at the start of the last step, and that step's size (s), for
+    // `far_from_crossing`; NaN: not known (the first step, or after a breakpoint).
+    let mut margins_before = vec![f64::NAN; watches.len()];
+    let mut h_before = 0.0;
     // Set when the state went non-finite: the time of the last finite state (held in `buf`).
     let mut last_good: Option<f64> = None;
     let mut last_poll = Instant::now();
@@ -480,6 +484,7 @@ fn drive<M: Stepper>(
             buf.copy_from_slice(stepper.y());
             sc.at_breakpoint(t0, &mut buf);
             stepper.restart(sc, &buf);
+            margins_before.fill(f64::NAN);
         }
         let stop = next_stop(sc, t0, t_end);
         if let Err(e) = stepper.step(sc, stop) {
@@ -588,15 +593,41 @@ fn drive<M: Stepper>(
         // (event time, time known, condition, terminal)
         let mut found: Vec<(f64, f64, &Condition, bool)> = Vec::new();
         if let Some(o1) = &o1 {
+            // Interior points only where a margin could cross and re-cross inside the step
+            // (`far_from_crossing`): elsewhere the step's ends decide, and the dense output
+            // is not needed.
+            let h = t1 - t0;
+            let mut near = false;
+            for (watch, g_before) in watches.iter().zip(margins_before.iter_mut()) {
+                let (ga, gb) = (watch.condition.margin(&prev), watch.condition.margin(o1));
+                near |= watch.active() && !far_from_crossing(*g_before, ga, gb, h_before, h);
+                *g_before = ga;
+            }
+            h_before = h;
+            let checks = if near { interior_checks } else { 0 };
+            if checks > 0 && !stepper.prepare_interpolation(sc) {
+                status = Some(dense_failure(t0, t1, stepper.y(), sim));
+                break;
+            }
             // Reused across steps: no allocation per step once it has grown.
             grid.clear();
             grid.push((t0, prev.clone()));
-            for j in 1..=interior_checks {
-                let t = t0 + (t1 - t0) * j as f64 / (interior_checks + 1) as f64;
+            for j in 1..=checks {
+                let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
                 stepper.interpolate(t, &mut buf);
                 grid.push((t, sc.observe(t, &buf)));
             }
             grid.push((t1, o1.clone()));
+            // A sign change is located on the dense output.
+            let bracketed = watches.iter().filter(|w| w.active()).any(|w| {
+                grid.windows(2).any(|p| {
+                    (w.condition.margin(&p[0].1) > 0.0) != (w.condition.margin(&p[1].1) > 0.0)
+                })
+            });
+            if bracketed && !stepper.prepare_interpolation(sc) {
+                status = Some(dense_failure(t0, t1, stepper.y(), sim));
+                break;
+            }
             for watch in watches.iter_mut().filter(|w| w.active()) {
                 let c = watch.condition;
                 for w in grid.windows(2) {
@@ -634,6 +665,12 @@ fn drive<M: Stepper>(
         }
         let stop_at = found.last().filter(|f| f.3).map(|f| f.1);
         let horizon = stop_at.unwrap_or(t1);
+        // Samples and events inside the step are read from the dense output.
+        let inside = (next_k as f64 / rate) < horizon.min(t1) || !found.is_empty();
+        if inside && !stepper.prepare_interpolation(sc) {
+            status = Some(dense_failure(t0, t1, stepper.y(), sim));
+            break;
+        }
 
         // Samples on the grid up to the horizon, interleaved with events in time order.
         let mut pending = found.iter().peekable();
@@ -732,6 +769,18 @@ fn drive<M: Stepper>(
         samples,
         wall_time: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The diagnosis when a step's deferred dense output comes out non-finite.
+fn dense_failure(t0: f64, t1: f64, y: &[f64], sim: &Simulation) -> Status {
+    let what = format!(
+        "the dense output of the step from t = {} to t = {} came out non-finite",
+        seconds(t0),
+        seconds(t1)
+    );
+    Status::Failed {
+        diagnosis: diagnose(&what, t1, y, sim),
+    }
 }
 
 /// Locates the root of `margin` in `[a, b]` on the dense output (Illinois regula falsi),

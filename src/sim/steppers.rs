@@ -46,7 +46,8 @@ impl AnyStepper {
     /// The stepper for `scenario`'s method, starting at `(0, y0)`; `Err` (a diagnosis) when
     /// the method cannot treat this spacecraft. Without `dense_output`, a method may skip
     /// the work that only interpolation needs (dop853's three extra stages), and then
-    /// `interpolate` is valid at the step's ends only.
+    /// `interpolate` is valid at the step's ends only. With it, that work may be deferred:
+    /// call [`Stepper::prepare_interpolation`] before interpolating inside a step.
     pub fn for_simulation(
         sim: &Simulation,
         y0: &[f64],
@@ -82,7 +83,12 @@ impl AnyStepper {
             }
             Method::Dop853(a) => {
                 let (t, m) = tol(a);
-                AnyStepper::Dop853(Dop853::new(0.0, y0, t, m, None).with_dense_output(dense_output))
+                let stepper = Dop853::new(0.0, y0, t, m, None);
+                AnyStepper::Dop853(if dense_output {
+                    stepper.with_lazy_dense_output()
+                } else {
+                    stepper.with_dense_output(false)
+                })
             }
             Method::Lie { dt } => AnyStepper::Lie(LieStepper::new(0.0, y0, dt)),
             Method::Splitting { dt, order } => {
@@ -125,6 +131,9 @@ impl Stepper for AnyStepper {
     }
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         each!(self, s => s.interpolate(t, out))
+    }
+    fn prepare_interpolation<S: OdeSystem + ?Sized>(&mut self, sys: &S) -> bool {
+        each!(self, s => s.prepare_interpolation(sys))
     }
     fn stats(&self) -> Stats {
         each!(self, s => s.stats())
