@@ -222,11 +222,23 @@ impl ParticleModel for HingedRod {
         out.first_moment = p1;
         // Σ m (|r|² 1 − r rᵀ) with Σ m r rᵀ = m g gᵀ + (m₂ − m₁²/m) ê êᵀ, g = p1/m (the rod's
         // centre of mass).
-        let g = p1 / m;
-        let spread = m2 - m1 * m1 / m;
-        out.inertia = Matrix3::from_diagonal_element(m * g.norm_squared() + spread)
-            - m * g * g.transpose()
-            - spread * e * e.transpose();
+        // Entry by entry (symmetric): m g gᵀ = p₁ p₁ᵀ/m.
+        let inv_m = 1.0 / m;
+        let spread = m2 - m1 * m1 * inv_m;
+        let trace = p1.norm_squared() * inv_m + spread;
+        let entry = |i: usize, j: usize| -(p1[i] * p1[j] * inv_m + spread * e[i] * e[j]);
+        let (xy, xz, yz) = (entry(0, 1), entry(0, 2), entry(1, 2));
+        out.inertia = Matrix3::new(
+            trace + entry(0, 0),
+            xy,
+            xz,
+            xy,
+            trace + entry(1, 1),
+            yz,
+            xz,
+            yz,
+            trace + entry(2, 2),
+        );
         out.force = force;
         out.moment = h.cross(&force) + e.cross(&force_s);
         true

@@ -284,7 +284,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
                 &mut sums,
             );
         }
-        let mut forces = [0.0; MAX_COORDINATES];
+        let mut forces = [0.0; N];
         self.model.forces(q, u, &mut forces[..n]);
         let mut g = sums.inertial;
         for k in 0..n {
