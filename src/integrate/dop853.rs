@@ -331,6 +331,8 @@ impl Dop853 {
     /// [`Stepper::prepare_interpolation`] asks for them: a step that is never interpolated
     /// inside costs 12 evaluations instead of 15. The interpolant is bit-for-bit the eager one
     /// (the same stages from the same values, which stay in place until the next step).
+    /// Deferred stages cannot reject their step: `prepare_interpolation` reports whether they
+    /// are finite, and the caller decides.
     pub fn with_lazy_dense_output(mut self) -> Self {
         self.dense = DenseOutput::Lazy;
         self
