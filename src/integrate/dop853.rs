@@ -692,8 +692,6 @@ impl Stepper for Dop853 {
         }
     }
 
-    /// Seventh-order interpolant of the last accepted step. Panics for a time strictly inside
-    /// the step if dense output was switched off ([`Dop853::with_dense_output`]).
     fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]) {
         // The dense output of the step before the breakpoint stays readable.
         self.prepare_interpolation(sys);
@@ -723,6 +721,9 @@ impl Stepper for Dop853 {
         finite
     }
 
+    /// Seventh-order interpolant of the last accepted step. Panics for a time strictly inside
+    /// the step if dense output was switched off ([`Dop853::with_dense_output`]), or deferred
+    /// ([`Dop853::with_lazy_dense_output`]) and not prepared.
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let h = self.t - self.t_prev;
         // The step's ends are returned as stored.
