@@ -143,18 +143,13 @@ impl ShapeIntegrals {
         out: &mut ParticleSums<N>,
     ) {
         // Compiled for one to four modes (fixed loop bounds), and for any number up to ten.
-        let n = geometry.directions.len() * self.modes;
         match self.modes {
-            1 => copy_sums(&self.sums_sized::<1, 4, 2>(geometry, q, u, omega), out, n),
-            2 => copy_sums(&self.sums_sized::<2, 7, 4>(geometry, q, u, omega), out, n),
-            3 => copy_sums(&self.sums_sized::<3, 11, 6>(geometry, q, u, omega), out, n),
-            4 => copy_sums(&self.sums_sized::<4, 16, 8>(geometry, q, u, omega), out, n),
-            _ => copy_sums(
-                &self.sums_sized::<MAX_MODES, MAX_FEATURES, MAX_BEAM_COORDINATES>(
-                    geometry, q, u, omega,
-                ),
-                out,
-                n,
+            1 => self.sums_sized::<1, 4, 2, N>(geometry, q, u, omega, out),
+            2 => self.sums_sized::<2, 7, 4, N>(geometry, q, u, omega, out),
+            3 => self.sums_sized::<3, 11, 6, N>(geometry, q, u, omega, out),
+            4 => self.sums_sized::<4, 16, 8, N>(geometry, q, u, omega, out),
+            _ => self.sums_sized::<MAX_MODES, MAX_FEATURES, MAX_BEAM_COORDINATES, N>(
+                geometry, q, u, omega, out,
             ),
         }
     }
@@ -171,29 +166,31 @@ impl ShapeIntegrals {
     }
 
     /// [`ShapeIntegrals::sums`] for `NM` modes and `F` features (see
-    /// [`ShapeIntegrals::sizes`]), `C` ≥ 2 `NM` coordinates. (Indexed loops, as the formulas
-    /// are written.)
+    /// [`ShapeIntegrals::sizes`]), `C` ≥ 2 `NM` coordinates, written into `out` (zero on
+    /// entry). (Indexed loops, as the formulas are written.)
     #[allow(clippy::needless_range_loop)]
-    fn sums_sized<const NM: usize, const F: usize, const C: usize>(
+    fn sums_sized<const NM: usize, const F: usize, const C: usize, const N: usize>(
         &self,
         geometry: &Geometry,
         q: &[f64],
         u: &[f64],
         omega: &Vector3<f64>,
-    ) -> ParticleSums<C> {
+        out: &mut ParticleSums<N>,
+    ) {
         let (nm, nf) = self.sizes::<NM, F>();
         let dirs = geometry.directions;
         let axis = geometry.axis;
         let w = omega;
         let stiff = geometry.stiffening;
         let wm = &self.moments[..nf * nf];
-        let mut out = ParticleSums::<C>::default();
         // Coefficients of position, relative velocity, κ and c (without stiffening the S_ij
         // ones are zero, and so are their products below).
         let (a_r, a_v, a_k) = self.coefficients::<NM, F>(geometry, q, u);
         let mut a_c = [Vector3::zeros(); F];
+        // ω × (ω × a) = ω (ω·a) − a ω².
+        let w2 = w.norm_squared();
         for f in 0..nf {
-            a_c[f] = w.cross(&w.cross(&a_r[f])) + 2.0 * w.cross(&a_v[f]) + a_k[f];
+            a_c[f] = w * w.dot(&a_r[f]) - w2 * a_r[f] + 2.0 * w.cross(&a_v[f]) + a_k[f];
         }
         // K[g] = Σ_f W_fg A_r[f],  B[g] = Σ_f W_fg A_c[f].
         let mut k = [Vector3::zeros(); F];
@@ -270,7 +267,6 @@ impl ShapeIntegrals {
                 }
             }
         }
-        out
     }
 
     /// The coefficients A_r, A_v and A_κ at `q` and `u` (`NM` and `F` as in
@@ -381,24 +377,6 @@ impl ShapeIntegrals {
         out.kinetic_energy = 0.5 * energy;
         out
     }
-}
-
-/// Copies the first `n` coordinates' sums (and the rest) from `from` to `to`.
-fn copy_sums<const C: usize, const N: usize>(
-    from: &ParticleSums<C>,
-    to: &mut ParticleSums<N>,
-    n: usize,
-) {
-    for k in 0..n {
-        to.mass[k][..=k].copy_from_slice(&from.mass[k][..=k]);
-        to.coupling[k] = from.coupling[k];
-        to.inertial[k] = from.inertial[k];
-    }
-    to.total_mass = from.total_mass;
-    to.first_moment = from.first_moment;
-    to.inertia = from.inertia;
-    to.force = from.force;
-    to.moment = from.moment;
 }
 
 #[cfg(test)]
