@@ -134,7 +134,10 @@ def test_progress_true_draws_a_tqdm_bar(capfd):
 def test_ctrl_c_raises_keyboard_interrupt_with_the_finished_runs():
     # 100 000 runs take minutes: SIGINT after 1 s stops the campaign.
     script = (
-        "import sys, time, polhode\n"
+        # Python's own Ctrl-C handler, as in an interactive session, even when this test
+        # runs as a background job (whose shell starts it with SIGINT ignored).
+        "import signal, sys, time, polhode\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         f"s = polhode.load({str(SINK)!r})\n"
         "print('running', flush=True)\n"
         "try:\n"
