@@ -15,7 +15,7 @@
 //! momentum and its energy is a quadratic polynomial in s, which that rule integrates exactly.
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
-use crate::model::{Drawing, Momentum, Validity};
+use crate::model::{Drawing, HubCoupling, Momentum, Validity};
 use crate::sincos::sin_cos;
 use nalgebra::{Matrix3, Vector3};
 
@@ -241,6 +241,105 @@ impl ParticleModel for HingedRod {
         );
         out.force = force;
         out.moment = h.cross(&force) + e.cross(&force_s);
+        true
+    }
+
+    /// The flap–lag rod's coordinates eliminated by hand (docs/effectors.md#hinged_rod): the
+    /// Jacobian columns ∂ê/∂θ_f and ∂ê/∂θ_l are orthogonal and both ⊥ ê, so the joint leaves
+    /// the rod free to turn about the hinge and `D − C M⁻¹ Cᵀ` is the hinge point carrying
+    /// the mass tensor (m − μ) 1 + μ ê êᵀ, μ = m₁²/m₂: a constant part plus μ v vᵀ,
+    /// v = [ê; h × ê]. With one freedom the columns do not span ⊥ ê, and the sums are used.
+    fn couple_closed_form(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        coupling: &mut HubCoupling,
+        kept: &mut [f64],
+    ) -> bool {
+        if self.freedom != HingeFreedom::FlapLag {
+            return false;
+        }
+        let angles = [q[0], q[1], u[0], u[1]];
+        let [e, e_f, e_l, kappa] = self.direction_at(angles);
+        let [flap, lag, flap_rate, lag_rate] = angles;
+        let cos2 = e_l.norm_squared(); // |∂ê/∂θ_l|² = cos² θ_f; |∂ê/∂θ_f| = 1
+        if cos2.is_nan() || cos2 <= 0.0 {
+            // Lag has no inertia: poison the hub solve, so the run stops with a diagnosis.
+            coupling.force[0] = f64::NAN;
+            kept.fill(f64::NAN);
+            return true;
+        }
+        let (m, h) = (self.mass, self.hinge);
+        let m1 = 0.5 * m * self.length;
+        let m2 = m * self.length * self.length / 3.0;
+        let mu = m1 * m1 / m2;
+        let rest = m - mu;
+        let q_flap = -self.stiffness[0] * flap - self.damping[0] * flap_rate;
+        let q_lag = -self.stiffness[1] * lag - self.damping[1] * lag_rate;
+        // The joint's generalised forces as a vector ⊥ ê: G = Σ_k Q_k ∂ê/∂θ_k / |∂ê/∂θ_k|².
+        let joint = q_flap * e_f + (q_lag / cos2) * e_l;
+        // The rod's acceleration terms free of the unknowns: a_h = ω × (ω × h) at the hinge,
+        // and along the rod λ = ê · (ω × (ω × ê) + 2 ω × ê̇ + κ).
+        let w2 = omega.norm_squared();
+        let e_rate = flap_rate * e_f + lag_rate * e_l;
+        let relative = 2.0 * omega.cross(&e_rate) + kappa;
+        let omega_e = omega.dot(&e);
+        let lambda = omega_e * omega_e - w2 + e.dot(&relative);
+        let a_h = omega * omega.dot(&h) - w2 * h;
+        // e + C M⁻¹ g: the force [(m − μ) 1 + μ ê êᵀ] a_h + m₁ λ ê + (m₁/m₂) G at the hinge,
+        // and the joint's torque ê × G.
+        let force = rest * a_h + (mu * e.dot(&a_h) + m1 * lambda) * e + (m1 / m2) * joint;
+        let moment = h.cross(&force) + e.cross(&joint);
+        for i in 0..3 {
+            coupling.force[i] -= force[i];
+            coupling.force[3 + i] -= moment[i];
+        }
+        // D − C M⁻¹ Cᵀ (lower triangle): (m − μ) [[1, −[h×]], [[h×], |h|² 1 − h hᵀ]] + μ v vᵀ.
+        let hub = &mut coupling.mass;
+        let s = rest * h;
+        for i in 0..3 {
+            hub[(i, i)] += rest;
+        }
+        hub[(4, 0)] += s.z;
+        hub[(5, 0)] -= s.y;
+        hub[(3, 1)] -= s.z;
+        hub[(5, 1)] += s.x;
+        hub[(3, 2)] += s.y;
+        hub[(4, 2)] -= s.x;
+        let h2 = h.norm_squared();
+        for i in 0..3 {
+            hub[(3 + i, 3 + i)] += rest * h2;
+            for j in 0..=i {
+                hub[(3 + i, 3 + j)] -= s[i] * h[j];
+            }
+        }
+        let he = h.cross(&e);
+        let v = [e.x, e.y, e.z, he.x, he.y, he.z];
+        for i in 0..6 {
+            let mu_vi = mu * v[i];
+            for j in 0..=i {
+                hub[(i, j)] += mu_vi * v[j];
+            }
+        }
+        // What `derivatives` reads: W_k = [g_k, Cᵀ_k] / M_kk with Cᵀ_k = [m₁ j_k, p₂ × j_k],
+        // g_k = Q_k − j_k · Σ m s c, and L = 1.
+        let p2 = m1 * h + m2 * e;
+        let force_s = omega * omega.dot(&p2) - w2 * p2 + m2 * relative;
+        for (k, (j, mass_k, q_k)) in [(e_f, m2, q_flap), (e_l, m2 * cos2, q_lag)]
+            .into_iter()
+            .enumerate()
+        {
+            let r = 1.0 / mass_k;
+            let moment = p2.cross(&j);
+            let row = &mut kept[7 * k..7 * k + 7];
+            row[0] = (q_k - j.dot(&force_s)) * r;
+            for a in 0..3 {
+                row[1 + a] = m1 * j[a] * r;
+                row[4 + a] = moment[a] * r;
+            }
+        }
+        kept[14..17].copy_from_slice(&[1.0, 0.0, 1.0]);
         true
     }
 

@@ -100,6 +100,22 @@ pub trait ParticleModel: Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// [`Effector::couple`] in closed form, for a model whose coordinates can be eliminated
+    /// by hand: adds `D − C M⁻¹ Cᵀ` to the lower triangle of `coupling.mass` and subtracts
+    /// `e + C M⁻¹ g` from `coupling.force` (the module documentation's terms), and writes
+    /// what `derivatives` reads into `kept` (W = M⁻¹ [g | Cᵀ], row-major with stride 7, then
+    /// the packed unit L of a diagonal M). Returns false, and `couple` eliminates the
+    /// coordinates from the sums instead, otherwise. Never called with tidal forces.
+    fn couple_closed_form(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _omega: &Vector3<f64>,
+        _coupling: &mut HubCoupling,
+        _kept: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// The particles' [`Momentum`] (relative to the hub's centre of mass, with the hub at rest
     /// and turning at `omega`) in closed form, for a model that has one; `None`, and the
     /// particles are summed instead, otherwise.
@@ -260,6 +276,30 @@ impl<P: ParticleModel> ParticleEffector<P> {
     /// matrices in registers), or for any number up to `N` = [`MAX_COORDINATES`], taken at
     /// run time. The arithmetic, and so every bit of the result, is the same either way.
     fn couple_sized<const N: usize>(
+        &self,
+        hub: &HubState,
+        x: &[f64],
+        coupling: &mut HubCoupling,
+        scratch: &mut [f64],
+    ) {
+        let n = if N < MAX_COORDINATES {
+            N
+        } else {
+            self.model.num_coordinates()
+        };
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let w = hub.omega;
+        if coupling.tidal.is_none() && self.model.couple_closed_form(q, u, &w, coupling, scratch) {
+            coupling.translation = true;
+            return;
+        }
+        self.couple_from_sums::<N>(hub, x, coupling, scratch);
+    }
+
+    /// [`Effector::couple`] from the particle sums (closed-form or summed particle by
+    /// particle), with the coordinates eliminated numerically: the reference for
+    /// [`ParticleModel::couple_closed_form`], and the path of every model without one.
+    fn couple_from_sums<const N: usize>(
         &self,
         hub: &HubState,
         x: &[f64],
@@ -760,6 +800,96 @@ mod tests {
                 closed_form_equals_particle_sums(&e, &state);
             }
         }
+    }
+
+    /// The flap–lag rod's coordinates eliminated by hand give the hub terms and the kept
+    /// W of the numerical elimination from its sums, to rounding; a non-finite state poisons
+    /// the hub's force, so the run stops with a diagnosis.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // the lower triangle, index by index
+    fn hinged_rod_closed_form_coupling_equals_the_elimination_from_its_sums() {
+        use super::super::hinged_rod::{HingeFreedom, HingedRod};
+        use nalgebra::{Matrix6, Vector6};
+        let rod = HingedRod {
+            mass: 0.139,
+            length: 0.56,
+            hinge: Vector3::new(0.03, 0.076, 0.1),
+            direction: Vector3::new(0.0, 0.6, 0.8),
+            axis: Vector3::new(1.0, 0.0, 0.0),
+            freedom: HingeFreedom::FlapLag,
+            stiffness: [0.565, 0.3],
+            damping: [6e-4, 1e-3],
+        };
+        let e = ParticleEffector::new("rod", rod, &[0.0; 2], &[0.0; 2]);
+        let start = HubCoupling {
+            mass: Matrix6::zeros(),
+            force: Vector6::zeros(),
+            translation: false,
+            tidal: None,
+        };
+        let mut worst = 0.0f64;
+        for k in 0..25 {
+            let a = k as f64;
+            // Angles over ±1.4 rad, rates over ±30 rad/s, the hub's rate up to 80 rad/s.
+            let x = [
+                1.4 * (0.7 * a).sin(),
+                -1.4 * (1.3 * a + 0.2).cos(),
+                30.0 * (0.9 * a + 1.0).sin(),
+                -20.0 * (0.4 * a).cos(),
+                0.0,
+            ];
+            let hub = HubState {
+                t: 0.0,
+                omega: Vector3::new(0.4 * a.cos(), -1.3, 3.2 * a),
+                attitude: &[1.0, 0.0, 0.0, 0.0],
+            };
+            let (mut closed, mut reference) = (start.clone(), start.clone());
+            let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
+            e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
+            e.couple_from_sums::<2>(&hub, &x, &mut reference, &mut kept_reference);
+            let mut close = |a: &[f64], b: &[f64], what: &str| {
+                let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (x, y) in a.iter().zip(b) {
+                    let error = (x - y).abs() / scale;
+                    worst = worst.max(error);
+                    assert!(
+                        error <= 1e-13,
+                        "{what}: by hand {x:e}, from the sums {y:e} (scale {scale:e}) at {x:?}"
+                    );
+                }
+            };
+            let lower = |m: &Matrix6<f64>| {
+                let mut v = Vec::new();
+                for i in 0..6 {
+                    for j in 0..=i {
+                        v.push(m[(i, j)]);
+                    }
+                }
+                v
+            };
+            close(&lower(&closed.mass), &lower(&reference.mass), "mass");
+            close(closed.force.as_slice(), reference.force.as_slice(), "force");
+            close(&kept_closed[..7], &kept_reference[..7], "W, flap row");
+            close(&kept_closed[7..14], &kept_reference[7..14], "W, lag row");
+            assert_eq!(kept_closed[14..], kept_reference[14..], "L");
+            assert!(closed.translation);
+        }
+        eprintln!("largest difference, relative to each quantity's scale: {worst:e}");
+        // A non-finite angle (lag's inertia cos² θ_f not positive) poisons the hub solve.
+        let mut poisoned = start.clone();
+        let mut kept = [0.0; 17];
+        let hub = HubState {
+            t: 0.0,
+            omega: Vector3::new(0.0, 0.0, 1.0),
+            attitude: &[1.0, 0.0, 0.0, 0.0],
+        };
+        e.couple_sized::<2>(
+            &hub,
+            &[f64::NAN, 0.0, 0.0, 0.0, 0.0],
+            &mut poisoned,
+            &mut kept,
+        );
+        assert!(poisoned.force[0].is_nan() && kept.iter().all(|v| v.is_nan()));
     }
 
     #[test]
