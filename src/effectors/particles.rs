@@ -418,6 +418,46 @@ impl<P: ParticleModel> ParticleEffector<P> {
         }
     }
 
+    /// [`Effector::derivatives`] for `N` coordinates, or any number up to `N` =
+    /// [`MAX_COORDINATES`] taken at run time (as [`ParticleEffector::couple_sized`]):
+    /// u̇ = L⁻ᵀ (W_g − W_C z), with W and L kept by `couple`.
+    fn derivatives_sized<const N: usize>(
+        &self,
+        accel: &HubAcceleration,
+        x: &[f64],
+        scratch: &[f64],
+        dx: &mut [f64],
+    ) {
+        let n = if N < MAX_COORDINATES {
+            N
+        } else {
+            self.model.num_coordinates()
+        };
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let z = accel.as_vector6();
+        let (w, l) = scratch[..7 * n + n * (n + 1) / 2].split_at(7 * n);
+        let mut u_dot = [0.0; N];
+        for (k, t) in u_dot[..n].iter_mut().enumerate() {
+            let wk = &w[k * 7..k * 7 + 7];
+            let mut s = wk[0];
+            for a in 0..6 {
+                s -= wk[1 + a] * z[a];
+            }
+            *t = s;
+        }
+        for i in (0..n).rev() {
+            let mut s = u_dot[i];
+            for k in i + 1..n {
+                s -= l[packed(k, i)] * u_dot[k];
+            }
+            u_dot[i] = s * l[packed(i, i)];
+        }
+        let (rates, rest) = dx.split_at_mut(n);
+        rates.copy_from_slice(u);
+        rest[..n].copy_from_slice(&u_dot[..n]);
+        rest[n] = self.model.dissipation_power(q, u);
+    }
+
     /// The particle sums by summing [`ParticleModel::particle`] over the particles (the
     /// reference form), with the gravity gradient's tidal forces when `tidal` is given (added
     /// to the inertial generalised forces and to the hub's `force`).
@@ -571,36 +611,19 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
 
     fn derivatives(
         &self,
-        hub: &HubState,
+        _hub: &HubState,
         accel: &HubAcceleration,
         x: &[f64],
         scratch: &[f64],
         dx: &mut [f64],
     ) {
-        let n = self.model.num_coordinates();
-        let (q, u) = (&x[..n], &x[n..2 * n]);
-        let z = accel.as_vector6();
-        dx[..n].copy_from_slice(u);
-        // u̇ = L⁻ᵀ (W_g − W_C z), with W and L kept by `couple`.
-        let (w, l) = scratch.split_at(7 * n);
-        let u_dot = &mut dx[n..2 * n];
-        for (k, t) in u_dot.iter_mut().enumerate() {
-            let wk = &w[k * 7..k * 7 + 7];
-            let mut s = wk[0];
-            for a in 0..6 {
-                s -= wk[1 + a] * z[a];
-            }
-            *t = s;
+        match self.model.num_coordinates() {
+            1 => self.derivatives_sized::<1>(accel, x, scratch, dx),
+            2 => self.derivatives_sized::<2>(accel, x, scratch, dx),
+            4 => self.derivatives_sized::<4>(accel, x, scratch, dx),
+            6 => self.derivatives_sized::<6>(accel, x, scratch, dx),
+            _ => self.derivatives_sized::<MAX_COORDINATES>(accel, x, scratch, dx),
         }
-        for i in (0..n).rev() {
-            let mut s = u_dot[i];
-            for k in i + 1..n {
-                s -= l[packed(k, i)] * u_dot[k];
-            }
-            u_dot[i] = s * l[packed(i, i)];
-        }
-        dx[2 * n] = self.model.dissipation_power(q, u);
-        let _ = hub;
     }
 
     fn momentum(&self, hub: &HubState, x: &[f64]) -> Momentum {
@@ -911,9 +934,8 @@ mod tests {
         }
     }
 
-    /// The fixed-size coupling (one, two, four or six coordinates) and the general one give
-    /// the same
-    /// bits: the same arithmetic, in the same order.
+    /// The fixed-size coupling and derivatives (one, two, four or six coordinates) and the
+    /// general ones give the same bits: the same arithmetic, in the same order.
     #[test]
     fn fixed_size_coupling_equals_the_general_one_bit_for_bit() {
         use super::super::hinged_rod::{HingeFreedom, HingedRod};
@@ -949,6 +971,22 @@ mod tests {
                 fixed.mass != Matrix6::identity() * 3.0,
                 "the coupling added something"
             );
+            // And the coordinates' accelerations from what the coupling kept.
+            let accel = HubAcceleration {
+                linear: Vector3::new(0.01, -0.02, 0.005),
+                angular: Vector3::new(0.3, 0.1, -0.2),
+                tidal_power: 0.0,
+            };
+            let (mut d1, mut d2) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+            match n {
+                1 => e.derivatives_sized::<1>(&accel, x, &s1, &mut d1),
+                2 => e.derivatives_sized::<2>(&accel, x, &s1, &mut d1),
+                4 => e.derivatives_sized::<4>(&accel, x, &s1, &mut d1),
+                _ => e.derivatives_sized::<6>(&accel, x, &s1, &mut d1),
+            }
+            e.derivatives_sized::<MAX_COORDINATES>(&accel, x, &s2, &mut d2);
+            assert_eq!(bits(&d1), bits(&d2));
+            assert!(d1[n..2 * n].iter().all(|v| *v != 0.0), "{d1:?}");
         }
         let rod = |freedom| HingedRod {
             mass: 0.3,
