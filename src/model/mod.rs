@@ -818,64 +818,66 @@ impl Spacecraft {
     }
 }
 
-/// Solves `m z = f` for a symmetric positive definite 6×6 `m` (lower triangle read) by its
-/// L D Lᵀ factorisation (L unit lower triangular, D diagonal): no square roots, and one
-/// reciprocal per row, with fixed-size loops the compiler unrolls (nalgebra's generic
-/// decomposition was a quarter of a one-damper scene's right-hand side, measured with perf).
-/// `None` when `m` is not positive definite.
+/// The inverse of a symmetric 3 × 3 matrix [[a, b, c], [b, d, e], [c, e, f]] by its
+/// cofactors; `None` unless it is positive definite (Sylvester's criterion: a, a d − b² and
+/// the determinant positive).
+#[inline(always)]
+fn spd_inverse3(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Option<Matrix3<f64>> {
+    let (c00, c01, c02) = (d * f - e * e, c * e - b * f, b * e - c * d);
+    let det = a * c00 + b * c01 + c * c02;
+    if !(a > 0.0 && a * d - b * b > 0.0 && det > 0.0) {
+        return None;
+    }
+    let (c11, c12, c22) = (a * f - c * c, b * c - a * e, a * d - b * b);
+    let r = 1.0 / det;
+    Some(Matrix3::new(
+        c00 * r,
+        c01 * r,
+        c02 * r,
+        c01 * r,
+        c11 * r,
+        c12 * r,
+        c02 * r,
+        c12 * r,
+        c22 * r,
+    ))
+}
+
+/// Solves `m z = f` for a symmetric positive definite 6×6 `m` (lower triangle read) by the
+/// Schur complement of its translational block: with m = [[A, Bᵀ], [B, C]] (3 × 3 blocks),
+/// X = B A⁻¹ and S = C − X Bᵀ, the rotational part is z_r = S⁻¹ (f_r − X f_t) and the
+/// translational one z_t = A⁻¹ f_t − Xᵀ z_r. Both 3 × 3 inverses are closed-form (cofactors),
+/// so the solve is straight-line code: no loops, no square roots, two reciprocals
+/// (a 6 × 6 L D Lᵀ with loops was a tenth of Explorer 1's right-hand side). `None` when
+/// `m` is not positive definite (A or S is not).
 #[inline]
-#[allow(clippy::needless_range_loop)] // index arithmetic mirrors the textbook algorithm
-fn ldlt_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
-    // l[i][k] (i > k) is L's entry; ld[i][k] = l[i][k] d_k; inv_d[j] = 1/d_j.
-    let mut l = [[0.0f64; 6]; 6];
-    let mut ld = [[0.0f64; 6]; 6];
-    let mut inv_d = [0.0f64; 6];
-    for j in 0..6 {
-        let mut d = m[(j, j)];
-        for k in 0..j {
-            d -= l[j][k] * ld[j][k];
-        }
-        if d.is_nan() || d <= 0.0 {
-            return None;
-        }
-        inv_d[j] = 1.0 / d;
-        for i in j + 1..6 {
-            let mut s = m[(i, j)];
-            for k in 0..j {
-                s -= ld[i][k] * l[j][k];
-            }
-            ld[i][j] = s;
-            l[i][j] = s * inv_d[j];
-        }
-    }
-    let mut z = [0.0f64; 6];
-    for i in 0..6 {
-        let mut s = f[i];
-        for k in 0..i {
-            s -= l[i][k] * z[k];
-        }
-        z[i] = s;
-    }
-    for i in 0..6 {
-        z[i] *= inv_d[i];
-    }
-    for i in (0..6).rev() {
-        let mut s = z[i];
-        for k in i + 1..6 {
-            s -= l[k][i] * z[k];
-        }
-        z[i] = s;
-    }
-    Some(Vector6::from(z))
+fn schur_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
+    let a_inv = spd_inverse3(
+        m[(0, 0)],
+        m[(1, 0)],
+        m[(2, 0)],
+        m[(1, 1)],
+        m[(2, 1)],
+        m[(2, 2)],
+    )?;
+    let b: Matrix3<f64> = m.fixed_view::<3, 3>(3, 0).into_owned();
+    let x = b * a_inv;
+    let s = |i: usize, j: usize| m[(3 + i, 3 + j)] - x.row(i).dot(&b.row(j));
+    let s_inv = spd_inverse3(s(0, 0), s(1, 0), s(2, 0), s(1, 1), s(2, 1), s(2, 2))?;
+    let f_t = Vector3::new(f[0], f[1], f[2]);
+    let f_r = Vector3::new(f[3], f[4], f[5]);
+    let z_r = s_inv * (f_r - x * f_t);
+    let z_t = a_inv * f_t - x.tr_mul(&z_r);
+    Some(Vector6::new(z_t[0], z_t[1], z_t[2], z_r[0], z_r[1], z_r[2]))
 }
 
 /// Solves the hub's equations for its accelerations.
 #[inline(always)]
 fn solve_hub(c: &HubCoupling) -> HubAcceleration {
     if c.translation {
-        // The generalised mass is symmetric positive definite: L D Lᵀ (LU if rounding
-        // spoils definiteness).
-        let solved = match ldlt_solve6(&c.mass, &c.force) {
+        // The generalised mass is symmetric positive definite: the Schur complement of its
+        // translational block (LU if rounding spoils definiteness).
+        let solved = match schur_solve6(&c.mass, &c.force) {
             Some(z) => Some(z),
             None => c.mass.lu().solve(&c.force),
         };
@@ -1032,17 +1034,24 @@ mod tests {
     }
 
     #[test]
-    fn ldlt_solves_a_positive_definite_system_and_refuses_an_indefinite_one() {
+    fn schur_solve_solves_a_positive_definite_system_and_refuses_an_indefinite_one() {
         // B Bᵀ + 1 is positive definite; only its lower triangle is stored.
         let b = Matrix6::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0 + 0.1 * i as f64);
         let full = b * b.transpose() + Matrix6::identity();
         let lower = Matrix6::from_fn(|i, j| if i >= j { full[(i, j)] } else { 0.0 });
         let f = Vector6::new(1.0, -2.0, 0.5, 3.0, -1.5, 0.25);
-        let z = ldlt_solve6(&lower, &f).expect("positive definite");
+        let z = schur_solve6(&lower, &f).expect("positive definite");
         let reference = full.lu().solve(&f).expect("regular");
         approx::assert_relative_eq!(z, reference, max_relative = 1e-12);
-        let mut indefinite = full;
+        // Indefinite in the rotational block (S), and in the translational one (A).
+        let mut indefinite = lower;
         indefinite[(4, 4)] = -1.0;
-        assert!(ldlt_solve6(&indefinite, &f).is_none());
+        assert!(schur_solve6(&indefinite, &f).is_none());
+        let mut indefinite = lower;
+        indefinite[(1, 1)] = 0.0;
+        assert!(schur_solve6(&indefinite, &f).is_none());
+        let mut not_a_number = lower;
+        not_a_number[(5, 2)] = f64::NAN;
+        assert!(schur_solve6(&not_a_number, &f).is_none());
     }
 }
