@@ -244,7 +244,7 @@ impl ParticleModel for HingedRod {
         true
     }
 
-    /// The flap–lag rod's coordinates eliminated by hand (docs/effectors.md#hinged_rod): the
+    /// The flap–lag rod's coordinates eliminated by hand (docs/effectors.md, closed forms): the
     /// Jacobian columns ∂ê/∂θ_f and ∂ê/∂θ_l are orthogonal and both ⊥ ê, so the joint leaves
     /// the rod free to turn about the hinge and `D − C M⁻¹ Cᵀ` is the hinge point carrying
     /// the mass tensor (m − μ) 1 + μ ê êᵀ, μ = m₁²/m₂: a constant part plus μ v vᵀ,

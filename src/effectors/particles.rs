@@ -833,17 +833,20 @@ mod tests {
     fn hinged_rod_closed_form_coupling_equals_the_elimination_from_its_sums() {
         use super::super::hinged_rod::{HingeFreedom, HingedRod};
         use nalgebra::{Matrix6, Vector6};
-        let rod = HingedRod {
-            mass: 0.139,
-            length: 0.56,
-            hinge: Vector3::new(0.03, 0.076, 0.1),
-            direction: Vector3::new(0.0, 0.6, 0.8),
-            axis: Vector3::new(1.0, 0.0, 0.0),
-            freedom: HingeFreedom::FlapLag,
-            stiffness: [0.565, 0.3],
-            damping: [6e-4, 1e-3],
-        };
-        let e = ParticleEffector::new("rod", rod, &[0.0; 2], &[0.0; 2]);
+        // Two geometries: hinge, rest direction and hinge axis (⊥ the direction).
+        let (s2, s3) = (0.5f64.sqrt(), (1.0f64 / 3.0).sqrt());
+        let geometries = [
+            (
+                Vector3::new(0.03, 0.076, 0.1),
+                Vector3::new(0.0, 0.6, 0.8),
+                Vector3::new(1.0, 0.0, 0.0),
+            ),
+            (
+                Vector3::new(-0.4, 0.2, -1.1),
+                Vector3::new(s2, s2, 0.0),
+                Vector3::new(-s3, s3, s3),
+            ),
+        ];
         let start = HubCoupling {
             mass: Matrix6::zeros(),
             force: Vector6::zeros(),
@@ -851,7 +854,24 @@ mod tests {
             tidal: None,
         };
         let mut worst = 0.0f64;
-        for k in 0..25 {
+        let rod = |(hinge, direction, axis): (Vector3<f64>, Vector3<f64>, Vector3<f64>)| {
+            let rod = HingedRod {
+                mass: 0.139,
+                length: 0.56,
+                hinge,
+                direction,
+                axis,
+                freedom: HingeFreedom::FlapLag,
+                stiffness: [0.565, 0.3],
+                damping: [6e-4, 1e-3],
+            };
+            ParticleEffector::new("rod", rod, &[0.0; 2], &[0.0; 2])
+        };
+        for (geometry, k) in geometries
+            .iter()
+            .flat_map(|g| (0..25).map(move |k| (*g, k)))
+        {
+            let e = rod(geometry);
             let a = k as f64;
             // Angles over ±1.4 rad, rates over ±30 rad/s, the hub's rate up to 80 rad/s.
             let x = [
@@ -870,14 +890,14 @@ mod tests {
             let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
             e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
             e.couple_from_sums::<2>(&hub, &x, &mut reference, &mut kept_reference);
-            let mut close = |a: &[f64], b: &[f64], what: &str| {
-                let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                for (x, y) in a.iter().zip(b) {
-                    let error = (x - y).abs() / scale;
+            let mut close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
+                let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (a, b) in by_hand.iter().zip(from_sums) {
+                    let error = (a - b).abs() / scale;
                     worst = worst.max(error);
                     assert!(
                         error <= 1e-13,
-                        "{what}: by hand {x:e}, from the sums {y:e} (scale {scale:e}) at {x:?}"
+                        "{what}: by hand {a:e}, from the sums {b:e} (scale {scale:e}) at {x:?}"
                     );
                 }
             };
@@ -898,7 +918,8 @@ mod tests {
             assert!(closed.translation);
         }
         eprintln!("largest difference, relative to each quantity's scale: {worst:e}");
-        // A non-finite angle (lag's inertia cos² θ_f not positive) poisons the hub solve.
+        let e = rod(geometries[0]);
+        // A non-finite angle makes lag's inertia (cos² θ_f) NaN, which poisons the hub solve.
         let mut poisoned = start.clone();
         let mut kept = [0.0; 17];
         let hub = HubState {
