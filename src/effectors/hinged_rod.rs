@@ -14,7 +14,7 @@
 //! Gauss–Legendre stations s = L/2 (1 ∓ 1/√3): every term of its equations of motion, its
 //! momentum and its energy is a quadratic polynomial in s, which that rule integrates exactly.
 
-use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums, add_mass_and_first_moment};
 use crate::model::{Drawing, HubCoupling, Momentum, Validity};
 use crate::sincos::sin_cos;
 use nalgebra::{Matrix3, Vector3};
@@ -298,15 +298,7 @@ impl ParticleModel for HingedRod {
         // D − C M⁻¹ Cᵀ (lower triangle): (m − μ) [[1, −[h×]], [[h×], |h|² 1 − h hᵀ]] + μ v vᵀ.
         let hub = &mut coupling.mass;
         let s = rest * h;
-        for i in 0..3 {
-            hub[(i, i)] += rest;
-        }
-        hub[(4, 0)] += s.z;
-        hub[(5, 0)] -= s.y;
-        hub[(3, 1)] -= s.z;
-        hub[(5, 1)] += s.x;
-        hub[(3, 2)] += s.y;
-        hub[(4, 2)] -= s.x;
+        add_mass_and_first_moment(hub, rest, &s);
         let h2 = h.norm_squared();
         for i in 0..3 {
             hub[(3 + i, 3 + i)] += rest * h2;

@@ -27,7 +27,7 @@ use crate::model::{
     Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
     TidalCoupling, Validity,
 };
-use nalgebra::{Matrix3, Vector3, Vector6};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use std::fmt::Debug;
 
 /// Largest number of coordinates a particle effector may have.
@@ -265,12 +265,38 @@ fn forward7<const N: usize>(l: &[[f64; N]; N], n: usize, b: &mut [[f64; 7]; N]) 
     }
 }
 
+/// Adds a mass `m` with first moment `s` about B (kg, kg m) to the lower triangle of the
+/// hub's 6 × 6 mass: `m` on the translational diagonal and `[s×]` in the rotation–translation
+/// block.
+pub(crate) fn add_mass_and_first_moment(hub: &mut Matrix6<f64>, m: f64, s: &Vector3<f64>) {
+    for i in 0..3 {
+        hub[(i, i)] += m;
+    }
+    hub[(4, 0)] += s.z;
+    hub[(5, 0)] -= s.y;
+    hub[(3, 1)] -= s.z;
+    hub[(5, 1)] += s.x;
+    hub[(3, 2)] += s.y;
+    hub[(4, 2)] -= s.x;
+}
+
 /// Index of L's entry (i, j), i ≥ j, packed row by row.
 fn packed(i: usize, j: usize) -> usize {
     i * (i + 1) / 2 + j
 }
 
 impl<P: ParticleModel> ParticleEffector<P> {
+    /// The number of coordinates in a copy compiled for `N`: `N` itself, a constant the
+    /// compiler folds into the loops, below [`MAX_COORDINATES`]; the model's, at run time,
+    /// for the general copy.
+    fn sized<const N: usize>(&self) -> usize {
+        if N < MAX_COORDINATES {
+            N
+        } else {
+            self.model.num_coordinates()
+        }
+    }
+
     /// [`Effector::couple`] for `N` coordinates when `N` is below [`MAX_COORDINATES`] (the
     /// loops then have fixed bounds, and the compiler unrolls them and keeps the small
     /// matrices in registers), or for any number up to `N` = [`MAX_COORDINATES`], taken at
@@ -282,11 +308,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
         coupling: &mut HubCoupling,
         scratch: &mut [f64],
     ) {
-        let n = if N < MAX_COORDINATES {
-            N
-        } else {
-            self.model.num_coordinates()
-        };
+        let n = self.sized::<N>();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let w = hub.omega;
         if coupling.tidal.is_none() && self.model.couple_closed_form(q, u, &w, coupling, scratch) {
@@ -306,11 +328,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
         coupling: &mut HubCoupling,
         scratch: &mut [f64],
     ) {
-        let n = if N < MAX_COORDINATES {
-            N
-        } else {
-            self.model.num_coordinates()
-        };
+        let n = self.sized::<N>();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let w = hub.omega;
         let mut sums = ParticleSums::<N>::default();
@@ -334,15 +352,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
         // [[m 1, ·], [[s×], Σ m (|r|² 1 − r rᵀ)]] with s = Σ m r.
         let (m_sum, s_sum, d_rr) = (sums.total_mass, sums.first_moment, &sums.inertia);
         let hub = &mut coupling.mass;
-        for i in 0..3 {
-            hub[(i, i)] += m_sum;
-        }
-        hub[(4, 0)] += s_sum.z;
-        hub[(5, 0)] -= s_sum.y;
-        hub[(3, 1)] -= s_sum.z;
-        hub[(5, 1)] += s_sum.x;
-        hub[(3, 2)] += s_sum.y;
-        hub[(4, 2)] -= s_sum.x;
+        add_mass_and_first_moment(hub, m_sum, &s_sum);
         for i in 0..3 {
             for j in 0..=i {
                 hub[(3 + i, 3 + j)] += d_rr[(i, j)];
@@ -428,11 +438,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
         scratch: &[f64],
         dx: &mut [f64],
     ) {
-        let n = if N < MAX_COORDINATES {
-            N
-        } else {
-            self.model.num_coordinates()
-        };
+        let n = self.sized::<N>();
         let (q, u) = (&x[..n], &x[n..2 * n]);
         let z = accel.as_vector6();
         let (w, l) = scratch[..7 * n + n * (n + 1) / 2].split_at(7 * n);
@@ -794,6 +800,18 @@ mod tests {
         close(&[a], &[b], "kinetic energy");
     }
 
+    /// The `k`-th of the rod states the tests sample: flap and lag over ±1.4 rad, their rates
+    /// over ±30 rad/s.
+    fn flap_lag_state(k: usize) -> [f64; 4] {
+        let a = k as f64;
+        [
+            1.4 * (0.7 * a).sin(),
+            -1.4 * (1.3 * a + 0.2).cos(),
+            30.0 * (0.9 * a + 1.0).sin(),
+            -20.0 * (0.4 * a).cos(),
+        ]
+    }
+
     #[test]
     fn hinged_rod_closed_form_sums_equal_its_particle_sums() {
         use super::super::hinged_rod::{HingeFreedom, HingedRod};
@@ -811,14 +829,7 @@ mod tests {
             let n = rod.num_coordinates();
             let e = ParticleEffector::new("rod", rod, &vec![0.0; n], &vec![0.0; n]);
             for k in 0..25 {
-                let a = k as f64;
-                // Angles over ±1.4 rad and rates over ±30 rad/s.
-                let x = [
-                    1.4 * (0.7 * a).sin(),
-                    -1.4 * (1.3 * a + 0.2).cos(),
-                    30.0 * (0.9 * a + 1.0).sin(),
-                    -20.0 * (0.4 * a).cos(),
-                ];
+                let x = flap_lag_state(k);
                 let state: Vec<f64> = if n == 2 { x.to_vec() } else { vec![x[0], x[2]] };
                 closed_form_equals_particle_sums(&e, &state);
             }
@@ -873,14 +884,9 @@ mod tests {
         {
             let e = rod(geometry);
             let a = k as f64;
-            // Angles over ±1.4 rad, rates over ±30 rad/s, the hub's rate up to 80 rad/s.
-            let x = [
-                1.4 * (0.7 * a).sin(),
-                -1.4 * (1.3 * a + 0.2).cos(),
-                30.0 * (0.9 * a + 1.0).sin(),
-                -20.0 * (0.4 * a).cos(),
-                0.0,
-            ];
+            let [flap, lag, flap_rate, lag_rate] = flap_lag_state(k);
+            let x = [flap, lag, flap_rate, lag_rate, 0.0];
+            // The hub's rate up to 80 rad/s.
             let hub = HubState {
                 t: 0.0,
                 omega: Vector3::new(0.4 * a.cos(), -1.3, 3.2 * a),
