@@ -76,6 +76,13 @@ impl HingedRod {
         [e, e_f, e_l, kappa]
     }
 
+    /// The rod's first and second moments of mass about the hinge, m₁ = ∫ s dm = m L/2
+    /// (kg m) and m₂ = ∫ s² dm = m L²/3 (kg m²).
+    fn moments(&self) -> (f64, f64) {
+        let m = self.mass;
+        (0.5 * m * self.length, m * self.length * self.length / 3.0)
+    }
+
     /// Tip position (m, body axes) at coordinates `q`.
     pub fn tip(&self, q: &[f64]) -> Vector3<f64> {
         let zeros = [0.0; 2];
@@ -191,8 +198,7 @@ impl ParticleModel for HingedRod {
             HingeFreedom::Lag => [e_l, Vector3::zeros()],
         };
         let (m, h) = (self.mass, self.hinge);
-        let m1 = 0.5 * m * self.length;
-        let m2 = m * self.length * self.length / 3.0;
+        let (m1, m2) = self.moments();
         // Σ m r = m h + m₁ ê and Σ m s r = m₁ h + m₂ ê.
         let p1 = m * h + m1 * e;
         let p2 = m1 * h + m2 * e;
@@ -260,9 +266,9 @@ impl ParticleModel for HingedRod {
         if self.freedom != HingeFreedom::FlapLag {
             return false;
         }
-        let angles = [q[0], q[1], u[0], u[1]];
+        let angles = self.angles(q, u);
         let [e, e_f, e_l, kappa] = self.direction_at(angles);
-        let [flap, lag, flap_rate, lag_rate] = angles;
+        let [_, _, flap_rate, lag_rate] = angles;
         let cos2 = e_l.norm_squared(); // |∂ê/∂θ_l|² = cos² θ_f; |∂ê/∂θ_f| = 1
         if cos2.is_nan() || cos2 <= 0.0 {
             // Lag has no inertia: poison the hub solve, so the run stops with a diagnosis.
@@ -271,12 +277,12 @@ impl ParticleModel for HingedRod {
             return true;
         }
         let (m, h) = (self.mass, self.hinge);
-        let m1 = 0.5 * m * self.length;
-        let m2 = m * self.length * self.length / 3.0;
+        let (m1, m2) = self.moments();
         let mu = m1 * m1 / m2;
         let rest = m - mu;
-        let q_flap = -self.stiffness[0] * flap - self.damping[0] * flap_rate;
-        let q_lag = -self.stiffness[1] * lag - self.damping[1] * lag_rate;
+        let mut joint_forces = [0.0; 2];
+        self.forces(q, u, &mut joint_forces);
+        let [q_flap, q_lag] = joint_forces;
         // The joint's generalised forces as a vector ⊥ ê: G = Σ_k Q_k ∂ê/∂θ_k / |∂ê/∂θ_k|².
         let joint = q_flap * e_f + (q_lag / cos2) * e_l;
         // The rod's acceleration terms free of the unknowns: a_h = ω × (ω × h) at the hinge,
@@ -341,8 +347,7 @@ impl ParticleModel for HingedRod {
         let angles = self.angles(q, u);
         let [e, e_f, e_l, _] = self.direction_at(angles);
         let (m, h) = (self.mass, self.hinge);
-        let m1 = 0.5 * m * self.length;
-        let m2 = m * self.length * self.length / 3.0;
+        let (m1, m2) = self.moments();
         let v_h = omega.cross(&h);
         let v_e = omega.cross(&e) + angles[2] * e_f + angles[3] * e_l;
         Some(Momentum {

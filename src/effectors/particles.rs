@@ -315,7 +315,7 @@ impl<P: ParticleModel> ParticleEffector<P> {
             coupling.translation = true;
             return;
         }
-        self.couple_from_sums::<N>(hub, x, coupling, scratch);
+        self.couple_from_sums::<N>(&w, q, u, coupling, scratch);
     }
 
     /// [`Effector::couple`] from the particle sums (closed-form or summed particle by
@@ -323,24 +323,16 @@ impl<P: ParticleModel> ParticleEffector<P> {
     /// [`ParticleModel::couple_closed_form`], and the path of every model without one.
     fn couple_from_sums<const N: usize>(
         &self,
-        hub: &HubState,
-        x: &[f64],
+        w: &Vector3<f64>,
+        q: &[f64],
+        u: &[f64],
         coupling: &mut HubCoupling,
         scratch: &mut [f64],
     ) {
         let n = self.sized::<N>();
-        let (q, u) = (&x[..n], &x[n..2 * n]);
-        let w = hub.omega;
         let mut sums = ParticleSums::<N>::default();
-        if coupling.tidal.is_some() || !self.model.summed(q, u, &w, &mut sums) {
-            self.sum_particles(
-                q,
-                u,
-                &w,
-                &mut coupling.tidal,
-                &mut coupling.force,
-                &mut sums,
-            );
+        if coupling.tidal.is_some() || !self.model.summed(q, u, w, &mut sums) {
+            self.sum_particles(q, u, w, &mut coupling.tidal, &mut coupling.force, &mut sums);
         }
         let mut forces = [0.0; N];
         self.model.forces(q, u, &mut forces[..n]);
@@ -895,7 +887,13 @@ mod tests {
             let (mut closed, mut reference) = (start.clone(), start.clone());
             let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
             e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
-            e.couple_from_sums::<2>(&hub, &x, &mut reference, &mut kept_reference);
+            e.couple_from_sums::<2>(
+                &hub.omega,
+                &x[..2],
+                &x[2..4],
+                &mut reference,
+                &mut kept_reference,
+            );
             let mut close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
                 let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 for (a, b) in by_hand.iter().zip(from_sums) {
