@@ -45,7 +45,7 @@ pub fn to_body(q: &[f64], v: &Vector3<f64>) -> Vector3<f64> {
     ((w * w - u2) * v + 2.0 * u.dot(v) * u - 2.0 * w * u.cross(v)) / (w * w + u2)
 }
 
-impl<T: EnvironmentTorque> Effector for T {
+impl<T: EnvironmentTorque + 'static> Effector for T {
     fn name(&self) -> &str {
         EnvironmentTorque::name(self)
     }

@@ -78,7 +78,7 @@ impl HingedRod {
 
     /// The rod's first and second moments of mass about the hinge, m₁ = ∫ s dm = m L/2
     /// (kg m) and m₂ = ∫ s² dm = m L²/3 (kg m²).
-    fn moments(&self) -> (f64, f64) {
+    pub(crate) fn moments(&self) -> (f64, f64) {
         let m = self.mass;
         (0.5 * m * self.length, m * self.length * self.length / 3.0)
     }

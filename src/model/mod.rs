@@ -27,6 +27,7 @@ pub use secular::{Secular, SecularMotion, SecularRates};
 
 use crate::integrate::OdeSystem;
 use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
+use std::any::Any;
 use std::cell::RefCell;
 use std::fmt::Debug;
 
@@ -238,7 +239,7 @@ impl Validity {
 /// State layout: `num_dynamic_states()` dynamic states first, then bookkeeping states (such as
 /// the dissipated energy) that nothing else depends on. Implementations must keep the counts
 /// fixed for their lifetime. An effector at rest has all-zero states.
-pub trait Effector: Debug + Send + Sync {
+pub trait Effector: Any + Debug + Send + Sync {
     /// Unique name within the spacecraft (used for telemetry topics).
     fn name(&self) -> &str;
     /// The kind as written in YAML (`rayleigh`, `hinged_rod`, …).
@@ -390,6 +391,20 @@ impl std::fmt::Display for AddEffectorError {
     }
 }
 
+/// Several effectors coupled in one call, in place of their own [`Effector::couple`] (the
+/// scene's flap–lag rods, lane by lane: [`crate::effectors::rod_lanes`]). Used when no
+/// tidal field acts on the moving masses; the members' `couple` serves otherwise.
+pub trait EffectorGroup: Debug + Send + Sync {
+    /// Indices of the member effectors in the spacecraft.
+    fn members(&self) -> &[usize];
+    /// Adds the members' terms to `coupling` and fills each member's scratch (the whole
+    /// spacecraft's `scratch`, at the members' offsets) as their own `couple` would.
+    fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]);
+    /// Writes the members' state derivatives into `dydt` (the whole state's), as their own
+    /// `derivatives` would after the group's `couple`.
+    fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]);
+}
+
 thread_local! {
     /// Per-thread scratch space for effectors (no allocation per right-hand-side call).
     static SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
@@ -423,6 +438,10 @@ pub struct Spacecraft {
     translation: bool,
     /// Every effector is [`Effector::torque_only`] (and there is at least one).
     torque_only: bool,
+    /// Effectors coupled together ([`EffectorGroup`]), rebuilt as effectors are added.
+    groups: Vec<Box<dyn EffectorGroup>>,
+    /// Whether each effector belongs to one of `groups`.
+    grouped: Vec<bool>,
     /// The effector whose field acts on the moving masses too, when some effector moves
     /// mass ([`Effector::acts_on_moving_masses`]).
     tidal_source: Option<usize>,
@@ -452,6 +471,8 @@ impl Spacecraft {
             scratch_len: 0,
             translation: false,
             torque_only: false,
+            groups: Vec::new(),
+            grouped: Vec::new(),
             tidal_source: None,
             dim: HUB_STATES,
         }
@@ -494,6 +515,18 @@ impl Spacecraft {
         self.scratch_lens.push(effector.scratch_len());
         self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
+        self.groups = crate::effectors::rod_lanes::RodLanes::groups(
+            &self.effectors,
+            &self.offsets,
+            &self.scratch_offsets,
+        )
+        .into_iter()
+        .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
+        .collect();
+        self.grouped = vec![false; self.effectors.len()];
+        for &k in self.groups.iter().flat_map(|g| g.members()) {
+            self.grouped[k] = true;
+        }
         Ok(())
     }
 
@@ -668,7 +701,13 @@ impl Spacecraft {
                 Some(TidalCoupling::new(gradient))
             }),
         };
+        // Grouped effectors couple through their group, unless a tidal field needs each
+        // particle (their own `couple` sums the particles then).
+        let use_groups = coupling.tidal.is_none();
         for (k, e) in self.effectors.iter().enumerate() {
+            if use_groups && self.grouped[k] {
+                continue;
+            }
             let off = self.offsets[k];
             let s = self.scratch_offsets[k];
             e.couple(
@@ -677,6 +716,11 @@ impl Spacecraft {
                 &mut coupling,
                 &mut scratch[s..s + self.scratch_lens[k]],
             );
+        }
+        if use_groups {
+            for group in &self.groups {
+                group.couple(hub, y, &mut coupling, scratch);
+            }
         }
         // Effectors may add to the lower triangle only (the mass matrix is symmetric).
         for i in 0..6 {
@@ -764,7 +808,11 @@ impl Spacecraft {
             if let Some(tidal) = &coupling.tidal {
                 accel.tidal_power = tidal.power(self.hub_mass.unwrap_or(0.0));
             }
+            let use_groups = coupling.tidal.is_none();
             for (k, e) in self.effectors.iter().enumerate() {
+                if use_groups && self.grouped[k] {
+                    continue;
+                }
                 let off = self.offsets[k];
                 let n = self.lens[k];
                 let s = self.scratch_offsets[k];
@@ -775,6 +823,11 @@ impl Spacecraft {
                     &scratch[s..s + self.scratch_lens[k]],
                     &mut dydt[off..off + n],
                 );
+            }
+            if use_groups {
+                for group in &self.groups {
+                    group.derivatives(&accel, y, &scratch, dydt);
+                }
             }
             accel.angular
         })
