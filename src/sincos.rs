@@ -95,6 +95,46 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     )
 }
 
+/// `(sin x, cos x)` of each of `N` arguments: [`sin_cos`]'s operations on each, bit for bit,
+/// arranged so that the compiler evaluates the reductions and polynomials of several
+/// arguments with each vector instruction (only the table's loads stay one by one).
+#[inline(always)]
+pub fn sin_cos_lanes<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
+    if x.iter()
+        .any(|v| v.is_nan() || (v * (STEPS as f64 / TAU)).abs() >= K_MAX)
+    {
+        let mut out = ([0.0; N], [0.0; N]);
+        for (i, v) in x.iter().enumerate() {
+            (out.0[i], out.1[i]) = sin_cos(*v);
+        }
+        return out;
+    }
+    let t = table();
+    let mut k = [0.0; N];
+    let mut k_int = [0i32; N];
+    for i in 0..N {
+        let y = x[i] * (STEPS as f64 / TAU);
+        // |y| < 2²⁷: the integer fits 32 bits, whose conversions take several lanes at once.
+        k_int[i] = (y + 0.5f64.copysign(y)) as i32;
+        k[i] = k_int[i] as f64;
+    }
+    let (mut s_j, mut c_j) = ([0.0; N], [0.0; N]);
+    for i in 0..N {
+        (s_j[i], c_j[i]) = t.values[(k_int[i] & (STEPS as i32 - 1)) as usize];
+    }
+    let mut out = ([0.0; N], [0.0; N]);
+    for i in 0..N {
+        let r = ((x[i] - k[i] * t.d1) - k[i] * t.d2) - k[i] * t.d3;
+        let r2 = r * r;
+        let sin_r = r + r * r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0)));
+        let cos_r_minus_1 =
+            r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40320.0))));
+        out.0[i] = s_j[i] + (s_j[i] * cos_r_minus_1 + c_j[i] * sin_r);
+        out.1[i] = c_j[i] + (c_j[i] * cos_r_minus_1 - s_j[i] * sin_r);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,5 +179,26 @@ mod tests {
             );
         }
         assert_eq!(sin_cos(0.0), (0.0, 1.0));
+    }
+
+    /// The lanes give [`sin_cos`]'s bits, argument by argument, also when one argument of
+    /// the batch is out of the reduction's range.
+    #[test]
+    fn lanes_equal_one_at_a_time_bit_for_bit() {
+        let bits = |(s, c): (f64, f64)| (s.to_bits(), c.to_bits());
+        for batch in 0..2000 {
+            let b = batch as f64;
+            let mut x: [f64; 8] = std::array::from_fn(|i| {
+                let a = b + 0.37 * i as f64;
+                (3.0 * a).sin() * 10f64.powf((a % 7.0) - 1.0)
+            });
+            if batch % 100 == 3 {
+                x[batch % 8] = [4e6, f64::NAN, -f64::INFINITY][batch % 3];
+            }
+            let (s, c) = sin_cos_lanes(x);
+            for i in 0..8 {
+                assert_eq!(bits((s[i], c[i])), bits(sin_cos(x[i])), "{}", x[i]);
+            }
+        }
     }
 }

@@ -12,7 +12,7 @@
 use super::hinged_rod::{HingeFreedom, HingedRod};
 use super::particles::{ParticleEffector, add_mass_and_first_moment};
 use crate::model::{Effector, EffectorGroup, HubAcceleration, HubCoupling, HubState};
-use crate::sincos::sin_cos;
+use crate::sincos::sin_cos_lanes;
 use nalgebra::{Matrix6, Vector3};
 use std::any::Any;
 
@@ -177,18 +177,16 @@ impl EffectorGroup for RodLanes {
         let omega = hub.omega;
         let w2 = omega.norm_squared();
         let mut angles = [[0.0; LANES]; 4];
-        let mut sines = [[0.0; LANES]; 4];
         for r in 0..LANES {
             let x = &y[self.state_offsets[r]..self.state_offsets[r] + 4];
             for (a, value) in angles.iter_mut().zip(x) {
                 a[r] = *value;
             }
-            let (sf, cf) = sin_cos(x[0]);
-            let (sl, cl) = sin_cos(x[1]);
-            for (s, value) in sines.iter_mut().zip([sf, cf, sl, cl]) {
-                s[r] = value;
-            }
         }
+        let mut both = [0.0; 2 * LANES];
+        both[..LANES].copy_from_slice(&angles[0]);
+        both[LANES..].copy_from_slice(&angles[1]);
+        let (sines, cosines) = sin_cos_lanes(both);
         // Per lane, what the rod's own closed form computes: the hinge force and moment
         // (times the lane's weight), v = [ê; h × ê] and the W rows.
         let mut force = [[0.0; LANES]; 3];
@@ -198,7 +196,7 @@ impl EffectorGroup for RodLanes {
         let mut cos2 = [0.0; LANES];
         for r in 0..LANES {
             let [f, l, df, dl] = [angles[0][r], angles[1][r], angles[2][r], angles[3][r]];
-            let [sf, cf, sl, cl] = [sines[0][r], sines[1][r], sines[2][r], sines[3][r]];
+            let (sf, cf, sl, cl) = (sines[r], cosines[r], sines[LANES + r], cosines[LANES + r]);
             let (rest, b, n, h) = (
                 lane(&self.rest, r),
                 lane(&self.binormal, r),
