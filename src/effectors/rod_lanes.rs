@@ -22,9 +22,9 @@ pub const LANES: usize = 4;
 /// One number per lane.
 type Lanes = [f64; LANES];
 
-/// Length of a flap–lag rod's scratch: W (2 rows of 7) and L (packed 2 × 2), as
-/// `ParticleEffector::couple` keeps them for `derivatives`.
-const ROD_SCRATCH: usize = 17;
+/// Entries of W per rod: two rows of 7, W_k = [g_k, Cᵀ_k] / M_kk (as the rod's closed form
+/// keeps them; its L is 1).
+const ROWS: usize = 14;
 
 /// A vector per lane: x, y and z components, each over the lanes.
 type LaneVectors = [Lanes; 3];
@@ -51,8 +51,6 @@ pub struct RodLanes {
     weight: Lanes,
     /// Offset of each lane's states `[θ_f, θ_l, θ̇_f, θ̇_l, …]` in the state vector.
     state_offsets: [usize; LANES],
-    /// Offset of each lane's scratch.
-    scratch_offsets: [usize; LANES],
     /// Hinge point h (m, body axes).
     hinge: LaneVectors,
     /// Rest direction ê₀.
@@ -78,9 +76,9 @@ pub struct RodLanes {
 }
 
 impl RodLanes {
-    /// The group of `rods`: (effector index, rod, state offset, scratch offset), at least one
-    /// and at most [`LANES`], each with both freedoms.
-    pub fn new(rods: &[(usize, &HingedRod, usize, usize)]) -> RodLanes {
+    /// The group of `rods`: (effector index, rod, state offset), at least one and at most
+    /// [`LANES`], each with both freedoms.
+    pub fn new(rods: &[(usize, &HingedRod, usize)]) -> RodLanes {
         assert!(!rods.is_empty() && rods.len() <= LANES);
         let zero = [[0.0; LANES]; 3];
         let mut group = RodLanes {
@@ -88,7 +86,6 @@ impl RodLanes {
             count: rods.len(),
             weight: [0.0; LANES],
             state_offsets: [0; LANES],
-            scratch_offsets: [0; LANES],
             hinge: zero,
             rest: zero,
             axis: zero,
@@ -103,13 +100,12 @@ impl RodLanes {
         };
         for r in 0..LANES {
             let used = r < rods.len();
-            let (_, rod, state, scratch) = rods[if used { r } else { 0 }];
+            let (_, rod, state) = rods[if used { r } else { 0 }];
             assert_eq!(rod.freedom, HingeFreedom::FlapLag);
             let (m1, m2) = rod.moments();
             let mu = m1 * m1 / m2;
             group.weight[r] = if used { 1.0 } else { 0.0 };
             group.state_offsets[r] = state;
-            group.scratch_offsets[r] = scratch;
             set_lane(&mut group.hinge, r, &rod.hinge);
             set_lane(&mut group.rest, r, &rod.direction);
             set_lane(&mut group.axis, r, &rod.axis);
@@ -141,23 +137,14 @@ impl RodLanes {
 
     /// The groups of a spacecraft's flap–lag rods, [`LANES`] at a time in the order the
     /// effectors come; a last rod left alone keeps its own `couple`.
-    pub fn groups(
-        effectors: &[Box<dyn Effector>],
-        state_offsets: &[usize],
-        scratch_offsets: &[usize],
-    ) -> Vec<RodLanes> {
+    pub fn groups(effectors: &[Box<dyn Effector>], state_offsets: &[usize]) -> Vec<RodLanes> {
         let rods: Vec<_> = effectors
             .iter()
             .enumerate()
             .filter_map(|(k, e)| {
                 let any: &dyn Any = e.as_ref();
                 let rod = any.downcast_ref::<ParticleEffector<HingedRod>>()?.model();
-                (rod.freedom == HingeFreedom::FlapLag).then_some((
-                    k,
-                    rod,
-                    state_offsets[k],
-                    scratch_offsets[k],
-                ))
+                (rod.freedom == HingeFreedom::FlapLag).then_some((k, rod, state_offsets[k]))
             })
             .collect();
         rods.chunks(LANES)
@@ -170,6 +157,10 @@ impl RodLanes {
 impl EffectorGroup for RodLanes {
     fn members(&self) -> &[usize] {
         &self.members
+    }
+
+    fn scratch_len(&self) -> usize {
+        ROWS * LANES
     }
 
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
@@ -192,7 +183,8 @@ impl EffectorGroup for RodLanes {
         let mut force = [[0.0; LANES]; 3];
         let mut moment = [[0.0; LANES]; 3];
         let mut v = [[0.0; LANES]; 6];
-        let mut rows = [[0.0; LANES]; 14];
+        // W, row entry by row entry, each over the lanes.
+        let (rows, _) = scratch.split_at_mut(ROWS * LANES);
         let mut cos2 = [0.0; LANES];
         for r in 0..LANES {
             let [f, l, df, dl] = [angles[0][r], angles[1][r], angles[2][r], angles[3][r]];
@@ -240,10 +232,10 @@ impl EffectorGroup for RodLanes {
             {
                 let inv = 1.0 / mass_k;
                 let torque = p2.cross(&j);
-                rows[7 * k][r] = (q_k - j.dot(&force_s)) * inv;
+                rows[7 * k * LANES + r] = (q_k - j.dot(&force_s)) * inv;
                 for a in 0..3 {
-                    rows[7 * k + 1 + a][r] = m1 * j[a] * inv;
-                    rows[7 * k + 4 + a][r] = torque[a] * inv;
+                    rows[(7 * k + 1 + a) * LANES + r] = m1 * j[a] * inv;
+                    rows[(7 * k + 4 + a) * LANES + r] = torque[a] * inv;
                 }
             }
         }
@@ -270,42 +262,40 @@ impl EffectorGroup for RodLanes {
             }
         }
         for r in 0..self.count {
-            let kept = &mut scratch[self.scratch_offsets[r]..self.scratch_offsets[r] + ROD_SCRATCH];
             if cos2[r].is_nan() || cos2[r] <= 0.0 {
                 // Lag has no inertia: poison the hub solve, so the run stops with a diagnosis.
                 coupling.force[0] = f64::NAN;
-                kept.fill(f64::NAN);
-                continue;
+                for row in 0..ROWS {
+                    rows[row * LANES + r] = f64::NAN;
+                }
             }
-            for (slot, row) in kept.iter_mut().zip(&rows) {
-                *slot = row[r];
-            }
-            kept[14..17].copy_from_slice(&[1.0, 0.0, 1.0]);
         }
         coupling.translation = true;
     }
 
+    #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
     fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]) {
         let z = accel.as_vector6();
-        for r in 0..self.count {
-            let (x, s) = (self.state_offsets[r], self.scratch_offsets[r]);
-            let kept = &scratch[s..s + ROD_SCRATCH];
-            // u̇ = W_g − W_C z (L = 1), as `ParticleEffector::derivatives`.
-            let mut u_dot = [0.0; 2];
-            for (k, t) in u_dot.iter_mut().enumerate() {
-                let row = &kept[7 * k..7 * k + 7];
-                let mut sum = row[0];
+        let rows = &scratch[..ROWS * LANES];
+        // u̇ = W_g − W_C z (L = 1), as `ParticleEffector::derivatives`, lane by lane.
+        let mut u_dot = [[0.0; LANES]; 2];
+        for (k, t) in u_dot.iter_mut().enumerate() {
+            for r in 0..LANES {
+                let mut sum = rows[7 * k * LANES + r];
                 for a in 0..6 {
-                    sum -= row[1 + a] * z[a];
+                    sum -= rows[(7 * k + 1 + a) * LANES + r] * z[a];
                 }
-                *t = sum;
+                t[r] = sum;
             }
+        }
+        for r in 0..self.count {
+            let x = self.state_offsets[r];
             let (flap_rate, lag_rate) = (y[x + 2], y[x + 3]);
             dydt[x..x + 5].copy_from_slice(&[
                 flap_rate,
                 lag_rate,
-                u_dot[0],
-                u_dot[1],
+                u_dot[0][r],
+                u_dot[1][r],
                 self.damping[0][r] * flap_rate * flap_rate
                     + self.damping[1][r] * lag_rate * lag_rate,
             ]);
@@ -382,21 +372,21 @@ mod tests {
                 rod(k, freedom)
             })
             .collect();
-        let (states, scratch, ..) = layout(&effectors);
-        let groups = RodLanes::groups(&effectors, &states, &scratch);
+        let (states, ..) = layout(&effectors);
+        let groups = RodLanes::groups(&effectors, &states);
         let members: Vec<_> = groups.iter().map(|g| g.members().to_vec()).collect();
         assert_eq!(members, vec![vec![0, 1, 3, 4], vec![5, 6]]);
-        let groups = RodLanes::groups(&effectors[..4], &states, &scratch);
+        let groups = RodLanes::groups(&effectors[..4], &states);
         let members: Vec<_> = groups.iter().map(|g| g.members().to_vec()).collect();
         assert_eq!(members, vec![vec![0, 1, 3]]);
-        assert!(RodLanes::groups(&effectors[..3], &states, &scratch)[0].members() == [0, 1]);
-        assert!(RodLanes::groups(&effectors[..1], &states, &scratch).is_empty());
+        assert!(RodLanes::groups(&effectors[..3], &states)[0].members() == [0, 1]);
+        assert!(RodLanes::groups(&effectors[..1], &states).is_empty());
     }
 
-    /// A group couples its rods as each rod's own `couple` does, to rounding: the hub's mass
-    /// and force, and each rod's kept W rows and L, for groups of 1 to 4 rods of different
-    /// geometries, at states spread over ±1.4 rad and ±30 rad/s; a non-finite angle poisons
-    /// the hub's force.
+    /// A group couples its rods as each rod's own `couple` and `derivatives` do, to
+    /// rounding: the hub's mass and force, and each rod's derivatives, for groups of 1 to 4
+    /// rods of different geometries, at states spread over ±1.4 rad and ±30 rad/s; a
+    /// non-finite angle poisons the hub's force and the rod's accelerations.
     #[test]
     fn a_group_couples_its_rods_as_each_rod_alone() {
         let mut worst = 0.0f64;
@@ -412,7 +402,7 @@ mod tests {
                 .map(|k| {
                     let any: &dyn Any = effectors[k].as_ref();
                     let rod = any.downcast_ref::<ParticleEffector<HingedRod>>().unwrap();
-                    (k, rod.model(), states[k], scratch_offsets[k])
+                    (k, rod.model(), states[k])
                 })
                 .collect();
             let group = RodLanes::new(&rods);
@@ -420,7 +410,7 @@ mod tests {
                 let a = sample as f64;
                 // Angles over ±1.4 rad, rates over ±30 rad/s.
                 let mut y = vec![0.0; dim];
-                for (r, &(_, _, offset, _)) in rods.iter().enumerate() {
+                for (r, &(_, _, offset)) in rods.iter().enumerate() {
                     let b = a + 5.0 * r as f64;
                     y[offset..offset + 4].copy_from_slice(&[
                         1.4 * (0.7 * b).sin(),
@@ -434,18 +424,31 @@ mod tests {
                     omega: Vector3::new(0.4 * a.cos(), -1.3, 4.0 * a),
                     attitude: &[1.0, 0.0, 0.0, 0.0],
                 };
+                let accel = HubAcceleration {
+                    linear: Vector3::new(0.3, -2.0, 0.7 * a),
+                    angular: Vector3::new(-1.1, 0.2 * a, 5.0),
+                    tidal_power: 0.0,
+                };
+                // Each rod alone: its couple, then its derivatives from what it kept.
                 let (mut alone, mut together) = (start(), start());
-                let (mut kept_alone, mut kept_together) = (vec![0.0; len], vec![0.0; len]);
+                let mut d_alone = vec![0.0; dim];
+                let mut kept = vec![0.0; len];
                 for &(k, ..) in &rods {
                     let (s, n) = (scratch_offsets[k], effectors[k].scratch_len());
-                    effectors[k].couple(
+                    let x = states[k]..states[k] + effectors[k].num_states();
+                    effectors[k].couple(&hub, &y[x.clone()], &mut alone, &mut kept[s..s + n]);
+                    effectors[k].derivatives(
                         &hub,
-                        &y[states[k]..states[k] + effectors[k].num_states()],
-                        &mut alone,
-                        &mut kept_alone[s..s + n],
+                        &accel,
+                        &y[x.clone()],
+                        &kept[s..s + n],
+                        &mut d_alone[x],
                     );
                 }
-                group.couple(&hub, &y, &mut together, &mut kept_together);
+                let mut own = vec![0.0; group.scratch_len()];
+                group.couple(&hub, &y, &mut together, &mut own);
+                let mut d_together = vec![0.0; dim];
+                group.derivatives(&accel, &y, &own, &mut d_together);
                 let mut close = |a: &[f64], b: &[f64], what: &str| {
                     let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                     for (x, y) in a.iter().zip(b) {
@@ -465,39 +468,18 @@ mod tests {
                 };
                 close(&lower(&together.mass), &lower(&alone.mass), "mass");
                 close(together.force.as_slice(), alone.force.as_slice(), "force");
-                for &(k, ..) in &rods {
-                    let s = scratch_offsets[k];
-                    for (row, what) in [(0, "W, flap row"), (7, "W, lag row")] {
-                        let range = s + row..s + row + 7;
-                        close(&kept_together[range.clone()], &kept_alone[range], what);
-                    }
-                    assert_eq!(kept_together[s + 14..s + 17], kept_alone[s + 14..s + 17]);
-                }
                 assert!(together.translation);
-                // The derivatives from the group's scratch, bit for bit the rods' own.
-                let accel = HubAcceleration {
-                    linear: Vector3::new(0.3, -2.0, 0.7 * a),
-                    angular: Vector3::new(-1.1, 0.2 * a, 5.0),
-                    tidal_power: 0.0,
-                };
-                let (mut d_alone, mut d_together) = (vec![0.0; dim], vec![0.0; dim]);
                 for &(k, ..) in &rods {
-                    let (s, n) = (scratch_offsets[k], effectors[k].scratch_len());
-                    let x = states[k]..states[k] + effectors[k].num_states();
-                    effectors[k].derivatives(
-                        &hub,
-                        &accel,
-                        &y[x.clone()],
-                        &kept_together[s..s + n],
-                        &mut d_alone[x],
-                    );
+                    let x = states[k];
+                    // θ̇ and the dissipated power exactly; θ̈ to rounding.
+                    assert_eq!(d_together[x..x + 2], d_alone[x..x + 2]);
+                    assert_eq!(d_together[x + 4], d_alone[x + 4]);
+                    close(&d_together[x + 2..x + 4], &d_alone[x + 2..x + 4], "θ̈");
                 }
-                group.derivatives(&accel, &y, &kept_together, &mut d_together);
-                assert_eq!(d_together, d_alone);
-                // The one-freedom rod's scratch is not touched.
-                let s = scratch_offsets[1];
+                // The one-freedom rod's derivatives are not written.
+                let x = states[1];
                 assert!(
-                    kept_together[s..s + effectors[1].scratch_len()]
+                    d_together[x..x + effectors[1].num_states()]
                         .iter()
                         .all(|v| *v == 0.0)
                 );
@@ -505,8 +487,10 @@ mod tests {
                 let last = states[rods[count - 1].0];
                 y[last] = f64::NAN;
                 let mut poisoned = start();
-                group.couple(&hub, &y, &mut poisoned, &mut kept_together);
+                group.couple(&hub, &y, &mut poisoned, &mut own);
                 assert!(poisoned.force[0].is_nan());
+                group.derivatives(&accel, &y, &own, &mut d_together);
+                assert!(d_together[last + 2..last + 4].iter().all(|v| v.is_nan()));
             }
         }
         eprintln!("largest difference, relative to each quantity's scale: {worst:e}");

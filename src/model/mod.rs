@@ -397,11 +397,14 @@ impl std::fmt::Display for AddEffectorError {
 pub trait EffectorGroup: Debug + Send + Sync {
     /// Indices of the member effectors in the spacecraft.
     fn members(&self) -> &[usize];
-    /// Adds the members' terms to `coupling` and fills each member's scratch (the whole
-    /// spacecraft's `scratch`, at the members' offsets) as their own `couple` would.
+    /// Length of the group's own scratch space (f64s), which `couple` fills for
+    /// `derivatives`.
+    fn scratch_len(&self) -> usize;
+    /// Adds the members' terms to `coupling`, as their own `couple` would; `y` is the whole
+    /// state.
     fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]);
     /// Writes the members' state derivatives into `dydt` (the whole state's), as their own
-    /// `derivatives` would after the group's `couple`.
+    /// `couple` and `derivatives` would.
     fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]);
 }
 
@@ -442,6 +445,8 @@ pub struct Spacecraft {
     groups: Vec<Box<dyn EffectorGroup>>,
     /// Whether each effector belongs to one of `groups`.
     grouped: Vec<bool>,
+    /// Each group's scratch space (after the effectors').
+    group_scratch: Vec<std::ops::Range<usize>>,
     /// The effector whose field acts on the moving masses too, when some effector moves
     /// mass ([`Effector::acts_on_moving_masses`]).
     tidal_source: Option<usize>,
@@ -473,6 +478,7 @@ impl Spacecraft {
             torque_only: false,
             groups: Vec::new(),
             grouped: Vec::new(),
+            group_scratch: Vec::new(),
             tidal_source: None,
             dim: HUB_STATES,
         }
@@ -515,18 +521,24 @@ impl Spacecraft {
         self.scratch_lens.push(effector.scratch_len());
         self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
-        self.groups = crate::effectors::rod_lanes::RodLanes::groups(
-            &self.effectors,
-            &self.offsets,
-            &self.scratch_offsets,
-        )
-        .into_iter()
-        .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
-        .collect();
+        self.groups = crate::effectors::rod_lanes::RodLanes::groups(&self.effectors, &self.offsets)
+            .into_iter()
+            .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
+            .collect();
         self.grouped = vec![false; self.effectors.len()];
         for &k in self.groups.iter().flat_map(|g| g.members()) {
             self.grouped[k] = true;
         }
+        // The groups' scratch follows the effectors'.
+        self.group_scratch = self
+            .groups
+            .iter()
+            .scan(self.scratch_len, |start, g| {
+                let range = *start..*start + g.scratch_len();
+                *start = range.end;
+                Some(range)
+            })
+            .collect();
         Ok(())
     }
 
@@ -718,8 +730,8 @@ impl Spacecraft {
             );
         }
         if use_groups {
-            for group in &self.groups {
-                group.couple(hub, y, &mut coupling, scratch);
+            for (group, range) in self.groups.iter().zip(&self.group_scratch) {
+                group.couple(hub, y, &mut coupling, &mut scratch[range.clone()]);
             }
         }
         // Effectors may add to the lower triangle only (the mass matrix is symmetric).
@@ -800,8 +812,12 @@ impl Spacecraft {
         };
         SCRATCH.with(|cell| {
             let mut scratch = cell.borrow_mut();
-            if scratch.len() < self.scratch_len {
-                scratch.resize(self.scratch_len, 0.0);
+            let len = self
+                .group_scratch
+                .last()
+                .map_or(self.scratch_len, |r| r.end);
+            if scratch.len() < len {
+                scratch.resize(len, 0.0);
             }
             let coupling = self.coupling(&hub, y, &mut scratch);
             let mut accel = solve(&coupling);
@@ -825,8 +841,8 @@ impl Spacecraft {
                 );
             }
             if use_groups {
-                for group in &self.groups {
-                    group.derivatives(&accel, y, &scratch, dydt);
+                for (group, range) in self.groups.iter().zip(&self.group_scratch) {
+                    group.derivatives(&accel, y, &scratch[range.clone()], dydt);
                 }
             }
             accel.angular
