@@ -11,7 +11,7 @@
 
 use super::hinged_rod::{HingeFreedom, HingedRod};
 use super::particles::{ParticleEffector, add_mass_and_first_moment};
-use crate::model::{Effector, EffectorGroup, HubAcceleration, HubCoupling, HubState};
+use crate::model::{Effector, EffectorGroup, HubAcceleration, HubCoupling, HubState, Momentum};
 use crate::sincos::sin_cos_lanes;
 use nalgebra::{Matrix6, Vector3};
 use std::any::Any;
@@ -26,6 +26,9 @@ type Lanes = [f64; LANES];
 /// keeps them; its L is 1).
 const ROWS: usize = 14;
 
+/// Sines and cosines of the lanes' flap angles, then of their lag angles.
+type Sines = ([f64; 2 * LANES], [f64; 2 * LANES]);
+
 /// A vector per lane: x, y and z components, each over the lanes.
 type LaneVectors = [Lanes; 3];
 
@@ -37,6 +40,16 @@ fn set_lane(v: &mut LaneVectors, r: usize, value: &Vector3<f64>) {
     for (component, x) in v.iter_mut().zip(value.iter()) {
         component[r] = *x;
     }
+}
+
+/// A rod's direction ê, its derivatives ∂ê/∂θ_f and ∂ê/∂θ_l, and the lag circle's c and
+/// ∂c/∂θ_l (ê = cos θ_f c + sin θ_f n̂).
+struct Direction {
+    c: Vector3<f64>,
+    c_prime: Vector3<f64>,
+    e: Vector3<f64>,
+    e_f: Vector3<f64>,
+    e_l: Vector3<f64>,
 }
 
 /// Up to [`LANES`] flap–lag rods coupled in one call. Lanes past `count` repeat lane 0 with
@@ -135,6 +148,44 @@ impl RodLanes {
         group
     }
 
+    /// Each lane's (θ_f, θ_l, θ̇_f, θ̇_l), each over the lanes, and the sines and cosines of
+    /// [θ_f (lanes); θ_l (lanes)].
+    #[inline(always)]
+    fn angles(&self, y: &[f64]) -> ([Lanes; 4], Sines) {
+        let mut angles = [[0.0; LANES]; 4];
+        for (r, &offset) in self.state_offsets.iter().enumerate() {
+            for (a, value) in angles.iter_mut().zip(&y[offset..offset + 4]) {
+                a[r] = *value;
+            }
+        }
+        let mut both = [0.0; 2 * LANES];
+        both[..LANES].copy_from_slice(&angles[0]);
+        both[LANES..].copy_from_slice(&angles[1]);
+        (angles, sin_cos_lanes(both))
+    }
+
+    /// Lane `r`'s ê and its derivatives (as `HingedRod::direction_at`), from the sines and
+    /// cosines of [`RodLanes::angles`].
+    #[inline(always)]
+    fn direction(&self, (s, c): &Sines, r: usize) -> Direction {
+        let (sf, cf, sl, cl) = (s[r], c[r], s[LANES + r], c[LANES + r]);
+        let (rest, b, n) = (
+            lane(&self.rest, r),
+            lane(&self.binormal, r),
+            lane(&self.axis, r),
+        );
+        let c = cl * rest + sl * b;
+        let c_prime = -sl * rest + cl * b;
+        let e = cf * c + sf * n;
+        Direction {
+            c,
+            c_prime,
+            e,
+            e_f: -sf * c + cf * n,
+            e_l: cf * c_prime,
+        }
+    }
+
     /// The groups of a spacecraft's flap–lag rods, [`LANES`] at a time in the order the
     /// effectors come; a last rod left alone keeps its own `couple`.
     pub fn groups(effectors: &[Box<dyn Effector>], state_offsets: &[usize]) -> Vec<RodLanes> {
@@ -164,20 +215,33 @@ impl EffectorGroup for RodLanes {
     }
 
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
+    fn momentum(&self, hub: &HubState, y: &[f64]) -> Momentum {
+        let omega = hub.omega;
+        let (angles, sines) = self.angles(y);
+        let mut sum = Momentum::default();
+        for r in 0..self.count {
+            let Direction { e, e_f, e_l, .. } = self.direction(&sines, r);
+            let (m, m1, m2) = (self.hinge_mass[r] + self.mu[r], self.m1[r], self.m2[r]);
+            let h = lane(&self.hinge, r);
+            // As `HingedRod::momentum_closed_form`: v(s) = v_h + s v_ê.
+            let v_h = omega.cross(&h);
+            let v_e = omega.cross(&e) + angles[2][r] * e_f + angles[3][r] * e_l;
+            sum.mass += m;
+            sum.first_moment += m * h + m1 * e;
+            sum.linear += m * v_h + m1 * v_e;
+            sum.angular +=
+                m * h.cross(&v_h) + m1 * (h.cross(&v_e) + e.cross(&v_h)) + m2 * e.cross(&v_e);
+            sum.kinetic_energy += 0.5 * (m * v_h.norm_squared() + 2.0 * m1 * v_h.dot(&v_e))
+                + 0.5 * m2 * v_e.norm_squared();
+        }
+        sum
+    }
+
+    #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
     fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
         let omega = hub.omega;
         let w2 = omega.norm_squared();
-        let mut angles = [[0.0; LANES]; 4];
-        for r in 0..LANES {
-            let x = &y[self.state_offsets[r]..self.state_offsets[r] + 4];
-            for (a, value) in angles.iter_mut().zip(x) {
-                a[r] = *value;
-            }
-        }
-        let mut both = [0.0; 2 * LANES];
-        both[..LANES].copy_from_slice(&angles[0]);
-        both[LANES..].copy_from_slice(&angles[1]);
-        let (sines, cosines) = sin_cos_lanes(both);
+        let (angles, sines) = self.angles(y);
         // Per lane, what the rod's own closed form computes: the hinge force and moment
         // (times the lane's weight), v = [ê; h × ê] and the W rows.
         let mut force = [[0.0; LANES]; 3];
@@ -188,20 +252,16 @@ impl EffectorGroup for RodLanes {
         let mut cos2 = [0.0; LANES];
         for r in 0..LANES {
             let [f, l, df, dl] = [angles[0][r], angles[1][r], angles[2][r], angles[3][r]];
-            let (sf, cf, sl, cl) = (sines[r], cosines[r], sines[LANES + r], cosines[LANES + r]);
-            let (rest, b, n, h) = (
-                lane(&self.rest, r),
-                lane(&self.binormal, r),
-                lane(&self.axis, r),
-                lane(&self.hinge, r),
-            );
+            let (sf, cf) = (sines.0[r], sines.1[r]);
+            let h = lane(&self.hinge, r);
             let (m1, m2, mu) = (self.m1[r], self.m2[r], self.mu[r]);
-            // ê and its derivatives (as `HingedRod::direction_at`).
-            let c = cl * rest + sl * b;
-            let c_prime = -sl * rest + cl * b;
-            let e = cf * c + sf * n;
-            let e_f = -sf * c + cf * n;
-            let e_l = cf * c_prime;
+            let Direction {
+                c,
+                c_prime,
+                e,
+                e_f,
+                e_l,
+            } = self.direction(&sines, r);
             let kappa = -cf * dl * dl * c - 2.0 * sf * df * dl * c_prime - df * df * e;
             let c2 = e_l.norm_squared();
             cos2[r] = c2;
@@ -384,7 +444,8 @@ mod tests {
     }
 
     /// A group couples its rods as each rod's own `couple` and `derivatives` do, to
-    /// rounding: the hub's mass and force, and each rod's derivatives, for groups of 1 to 4
+    /// rounding: the hub's mass and force, each rod's derivatives and the rods' summed
+    /// momentum, for groups of 1 to 4
     /// rods of different geometries, at states spread over ±1.4 rad and ±30 rad/s; a
     /// non-finite angle poisons the hub's force and the rod's accelerations.
     #[test]
@@ -476,6 +537,39 @@ mod tests {
                     assert_eq!(d_together[x + 4], d_alone[x + 4]);
                     close(&d_together[x + 2..x + 4], &d_alone[x + 2..x + 4], "θ̈");
                 }
+                // The momentum, summed.
+                let mut each = Momentum::default();
+                for &(k, ..) in &rods {
+                    let x = states[k]..states[k] + effectors[k].num_states();
+                    let m = effectors[k].momentum(&hub, &y[x]);
+                    each.mass += m.mass;
+                    each.first_moment += m.first_moment;
+                    each.linear += m.linear;
+                    each.angular += m.angular;
+                    each.kinetic_energy += m.kinetic_energy;
+                }
+                let sum = group.momentum(&hub, &y);
+                close(&[sum.mass], &[each.mass], "mass");
+                close(
+                    sum.first_moment.as_slice(),
+                    each.first_moment.as_slice(),
+                    "Σ m r",
+                );
+                close(
+                    sum.linear.as_slice(),
+                    each.linear.as_slice(),
+                    "linear momentum",
+                );
+                close(
+                    sum.angular.as_slice(),
+                    each.angular.as_slice(),
+                    "angular momentum",
+                );
+                close(
+                    &[sum.kinetic_energy],
+                    &[each.kinetic_energy],
+                    "kinetic energy",
+                );
                 // The one-freedom rod's derivatives are not written.
                 let x = states[1];
                 assert!(

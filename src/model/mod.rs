@@ -403,6 +403,8 @@ pub trait EffectorGroup: Debug + Send + Sync {
     /// Adds the members' terms to `coupling`, as their own `couple` would; `y` is the whole
     /// state.
     fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]);
+    /// The members' momentum, summed: the sum of their own [`Effector::momentum`].
+    fn momentum(&self, hub: &HubState, y: &[f64]) -> Momentum;
     /// Writes the members' state derivatives into `dydt` (the whole state's), as their own
     /// `couple` and `derivatives` would.
     fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]);

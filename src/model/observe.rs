@@ -109,14 +109,23 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
         let mut total_mass = sc.hub_mass.unwrap_or(0.0);
         let mut first_moment = Vector3::zeros();
         let mut linear = Vector3::zeros();
-        for (i, e) in sc.effectors().iter().enumerate() {
-            let x = sc.effector_states(i, y);
-            let m = e.momentum(&hub, x);
+        // Grouped effectors' momentum comes from their group, together.
+        let grouped = sc.groups.iter().map(|g| g.momentum(&hub, y));
+        let alone = sc
+            .effectors()
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !sc.grouped[*i]);
+        let alone = alone.map(|(i, e)| e.momentum(&hub, sc.effector_states(i, y)));
+        for m in alone.chain(grouped) {
             h_body += m.angular;
             kinetic_energy += m.kinetic_energy;
             total_mass += m.mass;
             first_moment += m.first_moment;
             linear += m.linear;
+        }
+        for (i, e) in sc.effectors().iter().enumerate() {
+            let x = sc.effector_states(i, y);
             let a = e.energy(&hub, x);
             elastic_energy += a.elastic;
             dissipated_energy += a.dissipated;
