@@ -693,6 +693,7 @@ impl Spacecraft {
 
     /// The hub's equations with every effector's terms added, at state `y`; effectors leave
     /// their intermediate results in `scratch`.
+    #[inline(always)]
     fn coupling(&self, hub: &HubState, y: &[f64], scratch: &mut [f64]) -> HubCoupling {
         let omega = hub.omega;
         let mut mass = Matrix6::zeros();
