@@ -17,7 +17,7 @@
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums, add_mass_and_first_moment};
 use crate::model::{Drawing, HubCoupling, Momentum, Validity};
 use crate::sincos::sin_cos;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3};
 
 /// Which joint angles are free.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -108,6 +108,21 @@ fn folded_flap(flap: f64) -> f64 {
     }
     let m = a % std::f64::consts::PI;
     m.min(std::f64::consts::PI - m)
+}
+
+/// Adds the hinge point's constant share of a flap–lag rod's D − C M⁻¹ Cᵀ to the lower
+/// triangle of the hub's mass: `rest` (m − μ, kg) at the hinge `h` (m, body axes),
+/// `rest` [[1, −[h×]], [[h×], |h|² 1 − h hᵀ]].
+pub(crate) fn add_hinge_mass(hub: &mut Matrix6<f64>, rest: f64, h: &Vector3<f64>) {
+    let s = rest * h;
+    add_mass_and_first_moment(hub, rest, &s);
+    let h2 = h.norm_squared();
+    for i in 0..3 {
+        hub[(3 + i, 3 + i)] += rest * h2;
+        for j in 0..=i {
+            hub[(3 + i, 3 + j)] -= s[i] * h[j];
+        }
+    }
 }
 
 /// Stations and weights of the 2-point Gauss rule on [0, 1].
@@ -314,15 +329,7 @@ impl ParticleModel for HingedRod {
         }
         // D − C M⁻¹ Cᵀ (lower triangle): (m − μ) [[1, −[h×]], [[h×], |h|² 1 − h hᵀ]] + μ v vᵀ.
         let hub = &mut coupling.mass;
-        let s = rest * h;
-        add_mass_and_first_moment(hub, rest, &s);
-        let h2 = h.norm_squared();
-        for i in 0..3 {
-            hub[(3 + i, 3 + i)] += rest * h2;
-            for j in 0..=i {
-                hub[(3 + i, 3 + j)] -= s[i] * h[j];
-            }
-        }
+        add_hinge_mass(hub, rest, &h);
         let he = h.cross(&e);
         let v = [e.x, e.y, e.z, he.x, he.y, he.z];
         for i in 0..6 {

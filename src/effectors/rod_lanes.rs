@@ -9,8 +9,8 @@
 //! instead of at every call. The result is each rod's own closed form to rounding (tested);
 //! the rods keep their own effectors for states, `derivatives`, momentum and telemetry.
 
-use super::hinged_rod::{HingeFreedom, HingedRod};
-use super::particles::{ParticleEffector, add_mass_and_first_moment};
+use super::hinged_rod::{HingeFreedom, HingedRod, add_hinge_mass};
+use super::particles::ParticleEffector;
 use crate::model::{Effector, EffectorGroup, HubAcceleration, HubCoupling, HubState, Momentum};
 use crate::sincos::sin_cos_lanes;
 use nalgebra::{Matrix6, Vector3};
@@ -132,17 +132,7 @@ impl RodLanes {
                 group.damping[k][r] = rod.damping[k];
             }
             if used {
-                let (rest, h) = (rod.mass - mu, rod.hinge);
-                let hub = &mut group.constant_mass;
-                let s = rest * h;
-                add_mass_and_first_moment(hub, rest, &s);
-                let h2 = h.norm_squared();
-                for i in 0..3 {
-                    hub[(3 + i, 3 + i)] += rest * h2;
-                    for j in 0..=i {
-                        hub[(3 + i, 3 + j)] -= s[i] * h[j];
-                    }
-                }
+                add_hinge_mass(&mut group.constant_mass, rod.mass - mu, &rod.hinge);
             }
         }
         group
@@ -551,25 +541,17 @@ mod tests {
                 let sum = group.momentum(&hub, &y);
                 close(&[sum.mass], &[each.mass], "mass");
                 close(
-                    sum.first_moment.as_slice(),
-                    each.first_moment.as_slice(),
-                    "Σ m r",
-                );
-                close(
-                    sum.linear.as_slice(),
-                    each.linear.as_slice(),
-                    "linear momentum",
-                );
-                close(
-                    sum.angular.as_slice(),
-                    each.angular.as_slice(),
-                    "angular momentum",
-                );
-                close(
                     &[sum.kinetic_energy],
                     &[each.kinetic_energy],
                     "kinetic energy",
                 );
+                for (together, alone, what) in [
+                    (sum.first_moment, each.first_moment, "Σ m r"),
+                    (sum.linear, each.linear, "linear momentum"),
+                    (sum.angular, each.angular, "angular momentum"),
+                ] {
+                    close(together.as_slice(), alone.as_slice(), what);
+                }
                 // The one-freedom rod's derivatives are not written.
                 let x = states[1];
                 assert!(
