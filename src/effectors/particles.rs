@@ -116,6 +116,23 @@ pub trait ParticleModel: Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// [`Effector::couple_alone`] in closed form: as
+    /// [`ParticleModel::couple_closed_form`], for the one effector of a scene that moves mass,
+    /// with the hub's translation (hub mass `hub_mass`, kg) eliminated too. Adds to the
+    /// rotational rows of `coupling` only, and keeps W with zero translational columns.
+    /// Returns false, having changed nothing, for a model without one. Never called with
+    /// tidal forces.
+    fn couple_alone_closed_form(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _omega: &Vector3<f64>,
+        _hub_mass: f64,
+        _coupling: &mut HubCoupling,
+        _kept: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// The particles' [`Momentum`] (relative to the hub's centre of mass, with the hub at rest
     /// and turning at `omega`) in closed form, for a model that has one; `None`, and the
     /// particles are summed instead, otherwise.
@@ -605,6 +622,22 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
             6 => self.couple_sized::<6>(hub, x, coupling, scratch),
             _ => self.couple_sized::<MAX_COORDINATES>(hub, x, coupling, scratch),
         }
+    }
+
+    fn couple_alone(
+        &self,
+        hub: &HubState,
+        hub_mass: f64,
+        x: &[f64],
+        coupling: &mut HubCoupling,
+        scratch: &mut [f64],
+    ) -> bool {
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        coupling.tidal.is_none()
+            && self
+                .model
+                .couple_alone_closed_form(q, u, &hub.omega, hub_mass, coupling, scratch)
     }
 
     fn derivatives(

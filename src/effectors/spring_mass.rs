@@ -6,7 +6,7 @@
 //! couple correctly through the hub.
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
-use crate::model::{Drawing, Momentum, Validity};
+use crate::model::{Drawing, HubCoupling, Momentum, Validity};
 use nalgebra::{Matrix3, Vector3};
 
 /// A spring–mass–dashpot damper.
@@ -78,6 +78,55 @@ impl ParticleModel for SpringMass {
         out.inertia = m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
         out.force = m * c;
         out.moment = r.cross(&out.force);
+        true
+    }
+    /// The two-body reduction: with the hub (mass M) and the particle sharing a fixed centre
+    /// of mass, a_B = −(m/(M + m)) (ω̇ × r + p̂ ρ̈ + c), and the particle moves as one of
+    /// reduced mass m* = m M/(M + m) about a fixed hub centre. Eliminating ρ̈ from
+    /// m* p̂·(ω̇ × r + p̂ ρ̈ + c) = Q then leaves (|p̂| = 1, t = r × p̂)
+    ///
+    /// ```text
+    /// (I + m* (|r|² 1 − r rᵀ − t tᵀ)) ω̇ = −ω × Iω − r × (m* (c − p̂ (p̂·c)) + p̂ Q),
+    /// ρ̈ = Q/m* − p̂·c − t·ω̇.
+    /// ```
+    ///
+    /// A direction that is not a unit vector takes the general path.
+    fn couple_alone_closed_form(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        hub_mass: f64,
+        coupling: &mut HubCoupling,
+        kept: &mut [f64],
+    ) -> bool {
+        let (p, rho_dot) = (self.direction, u[0]);
+        if (p.norm_squared() - 1.0).abs() > 1e-12 {
+            // Written for a unit direction (as scenarios give it); the general path otherwise.
+            return false;
+        }
+        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
+        let r = self.position + q[0] * p;
+        let c = omega.cross(&omega.cross(&r)) + 2.0 * rho_dot * omega.cross(&p);
+        let mut generalised = [0.0];
+        self.forces(q, u, &mut generalised);
+        let generalised = generalised[0];
+        let pc = p.dot(&c);
+        let t = r.cross(&p);
+        let pull = m_star * (c - pc * p) + generalised * p;
+        let moment = r.cross(&pull);
+        let r2 = r.norm_squared();
+        // The rotational block's lower triangle, m* (|r|² 1 − r rᵀ − t tᵀ), entry by entry.
+        let hub = &mut coupling.mass;
+        for (i, j) in [(0, 0), (1, 0), (2, 0), (1, 1), (2, 1), (2, 2)] {
+            let diagonal = if i == j { r2 } else { 0.0 };
+            hub[(3 + i, 3 + j)] += m_star * (diagonal - r[i] * r[j] - t[i] * t[j]);
+        }
+        for i in 0..3 {
+            coupling.force[3 + i] -= moment[i];
+        }
+        // W = [ρ̈ at ω̇ = 0 | 0 0 0 | t], and L = 1.
+        kept[..8].copy_from_slice(&[generalised / m_star - pc, 0.0, 0.0, 0.0, t.x, t.y, t.z, 1.0]);
         true
     }
     fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {

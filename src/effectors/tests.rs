@@ -152,6 +152,80 @@ fn one_damper_depends_on_the_masses_only_through_the_reduced_mass() {
     assert!((a[7] - b[7]).abs() < 1e-9 && (a[8] - b[8]).abs() < 1e-9);
 }
 
+/// A lone spring–mass eliminates the hub's translation itself (the two-body reduction,
+/// `SpringMass::couple_alone_closed_form`); the general path (its particle sums, the 6 × 6
+/// hub solve) must give the same right-hand side to rounding, with or without a wheel beside
+/// it, at states far from rest.
+#[test]
+fn a_lone_damper_reduced_by_hand_equals_the_general_path() {
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = |lo: f64, hi: f64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..24 {
+        let hub = RigidBody::from_principal([
+            uniform(30.0, 50.0),
+            uniform(30.0, 50.0),
+            uniform(30.0, 50.0),
+        ])
+        .unwrap();
+        let mut sc = Spacecraft::new(hub, Vector3::z());
+        sc.hub_mass = Some(uniform(20.0, 500.0));
+        let mut direction =
+            Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+        // The last cases keep a direction that is not a unit vector: the general path then.
+        if case < 20 {
+            direction = direction.normalize();
+        }
+        let smd = SpringMass {
+            mass: uniform(0.5, 30.0),
+            position: Vector3::new(uniform(-2.0, 2.0), uniform(-2.0, 2.0), uniform(-2.0, 2.0)),
+            direction,
+            stiffness: uniform(0.0, 100.0),
+            damping: uniform(0.0, 50.0),
+            travel: None,
+        };
+        sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0])))
+            .unwrap();
+        if case % 2 == 1 {
+            sc.add_effector(Box::new(WheelDamper {
+                name: "wheel".into(),
+                inertia: 0.3,
+                axis: Vector3::new(0.0, 0.6, 0.8),
+                damping: 0.2,
+                initial_rate: 1.5,
+                position: Vector3::zeros(),
+                max_speed: None,
+            }))
+            .unwrap();
+        }
+        let mut y = sc.initial_state(
+            &Vector3::new(uniform(-3.0, 3.0), uniform(-3.0, 3.0), uniform(-3.0, 3.0)),
+            &UnitQuaternion::from_euler_angles(uniform(-3.0, 3.0), uniform(-1.5, 1.5), 0.4),
+        );
+        let x = sc.effector_offset(0);
+        y[x] = uniform(-0.5, 0.5);
+        y[x + 1] = uniform(-2.0, 2.0);
+        let (mut reduced, mut general) = (vec![0.0; y.len()], vec![0.0; y.len()]);
+        sc.rhs(0.0, &y, &mut reduced);
+        sc.couple_alone_effector(false);
+        sc.rhs(0.0, &y, &mut general);
+        let scale = general.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for (k, (a, b)) in reduced.iter().zip(&general).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-13 * scale,
+                "case {case}, state {k}: {a:e} by hand, {b:e} in general (scale {scale:e})"
+            );
+        }
+        if case >= 20 {
+            assert_eq!(reduced, general, "case {case}: a non-unit direction");
+        }
+    }
+}
+
 fn explorer_rods(k: f64, c: f64) -> Spacecraft {
     let (m, ri, ro, len) = (13.9, 0.060, 0.076, 2.05);
     let iz = m * (ri * ri + ro * ro) / 2.0;

@@ -330,6 +330,23 @@ pub trait Effector: Any + Debug + Send + Sync {
     /// Adds its terms to the hub equations, given its own states `x`; may leave intermediate
     /// results in `scratch` for [`Effector::derivatives`].
     fn couple(&self, hub: &HubState, x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]);
+    /// [`Effector::couple`] for the one effector of a scene that moves mass, with the hub's
+    /// translation eliminated too: the hub (mass `hub_mass`, kg) and this effector then share
+    /// a fixed centre of mass, so a_B follows from the other accelerations. Adds to the
+    /// rotational rows of `coupling` only (the lower triangle of the rotational block and
+    /// `force[3..]`); the spacecraft then solves the rotational block alone and hands
+    /// `derivatives` a_B = 0. Returns false, having changed nothing, for an effector without
+    /// this form (the spacecraft calls `couple` instead). Never called with tidal forces.
+    fn couple_alone(
+        &self,
+        _hub: &HubState,
+        _hub_mass: f64,
+        _x: &[f64],
+        _coupling: &mut HubCoupling,
+        _scratch: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// Writes the derivatives of its own states given the hub accelerations.
     fn derivatives(
         &self,
@@ -452,6 +469,9 @@ pub struct Spacecraft {
     /// The effector whose field acts on the moving masses too, when some effector moves
     /// mass ([`Effector::acts_on_moving_masses`]).
     tidal_source: Option<usize>,
+    /// The one effector that moves mass, when there is exactly one: it may eliminate the
+    /// hub's translation itself ([`Effector::couple_alone`]).
+    alone: Option<usize>,
     dim: usize,
 }
 
@@ -482,6 +502,7 @@ impl Spacecraft {
             grouped: Vec::new(),
             group_scratch: Vec::new(),
             tidal_source: None,
+            alone: None,
             dim: HUB_STATES,
         }
     }
@@ -503,6 +524,11 @@ impl Spacecraft {
                     effector.name()
                 )));
             }
+            self.alone = if self.translation {
+                None
+            } else {
+                Some(self.effectors.len())
+            };
             self.translation = true;
         }
         if effector.acts_on_moving_masses() {
@@ -542,6 +568,20 @@ impl Spacecraft {
             })
             .collect();
         Ok(())
+    }
+
+    /// Whether a lone mass-moving effector may eliminate the hub's translation itself
+    /// ([`Effector::couple_alone`]; on by default): tests compare that path with the general
+    /// one.
+    #[cfg(test)]
+    pub(crate) fn couple_alone_effector(&mut self, on: bool) {
+        let movers: Vec<usize> = (0..self.effectors.len())
+            .filter(|&k| self.effectors[k].moves_mass())
+            .collect();
+        self.alone = match movers[..] {
+            [k] if on => Some(k),
+            _ => None,
+        };
     }
 
     /// Prescribes the hub's rotation (its centre of mass is then pinned in inertial space).
@@ -691,59 +731,79 @@ impl Spacecraft {
         self.hub.inertia_inv * (-omega.cross(&h))
     }
 
-    /// The hub's equations with every effector's terms added, at state `y`; effectors leave
-    /// their intermediate results in `scratch`.
+    /// The hub's equations with every effector's terms added, at state `y`, written into
+    /// `coupling` (zero on entry: built in place, as a returned value it was copied);
+    /// effectors leave their intermediate results in `scratch`. With `free_hub` (the hub's
+    /// translation free and solved for), a lone mass-moving effector may eliminate that
+    /// translation itself ([`Effector::couple_alone`]), and the coupling then has
+    /// `translation` false.
     #[inline(always)]
-    fn coupling(&self, hub: &HubState, y: &[f64], scratch: &mut [f64]) -> HubCoupling {
+    fn couple(
+        &self,
+        hub: &HubState,
+        y: &[f64],
+        scratch: &mut [f64],
+        free_hub: bool,
+        coupling: &mut HubCoupling,
+    ) {
         let omega = hub.omega;
-        let mut mass = Matrix6::zeros();
         // Torque-only scenes never read the mass matrix (see `rhs`).
         if !self.torque_only {
             let m = self.hub_mass.unwrap_or(1.0);
             for i in 0..3 {
-                mass[(i, i)] = m;
+                coupling.mass[(i, i)] = m;
             }
-            mass.fixed_view_mut::<3, 3>(3, 3)
+            coupling
+                .mass
+                .fixed_view_mut::<3, 3>(3, 3)
                 .copy_from(&self.hub.inertia);
         }
         let gyro = -omega.cross(&(self.hub.inertia * omega));
-        let mut coupling = HubCoupling {
-            mass,
-            force: Vector6::new(0.0, 0.0, 0.0, gyro[0], gyro[1], gyro[2]),
-            translation: self.translation,
-            tidal: self.tidal_source.and_then(|k| {
-                let gradient = self.effectors[k].tidal_gradient(hub)?;
-                Some(TidalCoupling::new(gradient))
-            }),
-        };
+        coupling.force[3] = gyro[0];
+        coupling.force[4] = gyro[1];
+        coupling.force[5] = gyro[2];
+        coupling.translation = self.translation;
+        if let Some(k) = self.tidal_source {
+            coupling.tidal = self.effectors[k]
+                .tidal_gradient(hub)
+                .map(TidalCoupling::new);
+        }
         // Grouped effectors couple through their group, unless a tidal field needs each
         // particle (their own `couple` sums the particles then).
         let use_groups = coupling.tidal.is_none();
+        let alone = self.alone.filter(|_| free_hub && use_groups);
         for (k, e) in self.effectors.iter().enumerate() {
             if use_groups && self.grouped[k] {
                 continue;
             }
             let off = self.offsets[k];
             let s = self.scratch_offsets[k];
-            e.couple(
-                hub,
+            let (x, scratch) = (
                 &y[off..off + self.lens[k]],
-                &mut coupling,
                 &mut scratch[s..s + self.scratch_lens[k]],
             );
+            if alone == Some(k) {
+                let hub_mass = self.hub_mass.unwrap_or(f64::NAN);
+                if e.couple_alone(hub, hub_mass, x, coupling, scratch) {
+                    coupling.translation = false;
+                    continue;
+                }
+            }
+            e.couple(hub, x, coupling, scratch);
         }
         if use_groups {
             for (group, range) in self.groups.iter().zip(&self.group_scratch) {
-                group.couple(hub, y, &mut coupling, &mut scratch[range.clone()]);
+                group.couple(hub, y, coupling, &mut scratch[range.clone()]);
             }
         }
-        // Effectors may add to the lower triangle only (the mass matrix is symmetric).
+        // Effectors add to the lower triangle only (the mass matrix is symmetric). The solves
+        // read the lower triangle alone, but a build without this copy computed wrong
+        // accelerations in one scene (docs/benchmarks.md, "A copy that must stay").
         for i in 0..6 {
             for j in 0..i {
                 coupling.mass[(j, i)] = coupling.mass[(i, j)];
             }
         }
-        coupling
     }
 
     /// Right-hand side of a scene whose effectors only apply torques (at most
@@ -805,6 +865,7 @@ impl Spacecraft {
         t: f64,
         y: &[f64],
         dydt: &mut [f64],
+        free_hub: bool,
         solve: impl FnOnce(&HubCoupling) -> HubAcceleration,
     ) -> Vector3<f64> {
         let omega = Vector3::new(y[0], y[1], y[2]);
@@ -822,7 +883,13 @@ impl Spacecraft {
             if scratch.len() < len {
                 scratch.resize(len, 0.0);
             }
-            let coupling = self.coupling(&hub, y, &mut scratch);
+            let mut coupling = HubCoupling {
+                mass: Matrix6::zeros(),
+                force: Vector6::zeros(),
+                translation: false,
+                tidal: None,
+            };
+            self.couple(&hub, y, &mut scratch, free_hub, &mut coupling);
             let mut accel = solve(&coupling);
             if let Some(tidal) = &coupling.tidal {
                 accel.tidal_power = tidal.power(self.hub_mass.unwrap_or(0.0));
@@ -867,7 +934,7 @@ impl Spacecraft {
         let omega = Vector3::new(y[0], y[1], y[2]);
         let wd = *omega_dot;
         let translation = self.translation;
-        self.effector_rhs(t, y, dydt, |c| {
+        self.effector_rhs(t, y, dydt, false, |c| {
             let linear = if free_translation && translation {
                 // Translational rows: M_tt a_B + M_tr ω̇ = f_t.
                 let m_tt = c.mass.fixed_view::<3, 3>(0, 0).into_owned();
@@ -966,12 +1033,22 @@ fn solve_hub(c: &HubCoupling) -> HubAcceleration {
             },
         }
     } else {
-        let m_rr = c.mass.fixed_view::<3, 3>(3, 3).into_owned();
+        // The rotational block alone (lower triangle read), by cofactors (nalgebra's general
+        // inverse if rounding spoils definiteness).
+        let m = &c.mass;
         let f_r = Vector3::new(c.force[3], c.force[4], c.force[5]);
+        let inverse = spd_inverse3(
+            m[(3, 3)],
+            m[(4, 3)],
+            m[(5, 3)],
+            m[(4, 4)],
+            m[(5, 4)],
+            m[(5, 5)],
+        )
+        .or_else(|| m.fixed_view::<3, 3>(3, 3).into_owned().try_inverse());
         HubAcceleration {
             linear: Vector3::zeros(),
-            angular: m_rr
-                .try_inverse()
+            angular: inverse
                 .map(|inv| inv * f_r)
                 .unwrap_or_else(|| Vector3::repeat(f64::NAN)),
             tidal_power: 0.0,
@@ -1011,13 +1088,13 @@ impl OdeSystem for Spacecraft {
             // I ω̇ = −ω × Iω + Σ τ: the inverse inertia is constant (the same inverse the
             // general solve computes from the same matrix, so the results are identical).
             let inverse = &self.hub.inertia_inv;
-            self.effector_rhs(t, y, dydt, |c| HubAcceleration {
+            self.effector_rhs(t, y, dydt, false, |c| HubAcceleration {
                 linear: Vector3::zeros(),
                 angular: inverse * Vector3::new(c.force[3], c.force[4], c.force[5]),
                 tidal_power: 0.0,
             })
         } else {
-            self.effector_rhs(t, y, dydt, solve_hub)
+            self.effector_rhs(t, y, dydt, true, solve_hub)
         };
         let hub_dy = &mut dydt[..HUB_STATES];
         hub_dy[0] = omega_dot[0];
