@@ -30,7 +30,7 @@
 // against the source by eye; the compiler rounds them to the nearest `f64`.
 #![allow(clippy::excessive_precision)]
 
-use super::{OdeSystem, Stats, StepError, Stepper, Tolerances};
+use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine};
 
 // Nodes (c₁ = 0, c₁₂ = c₁₃ = 1).
 const C2: f64 = 0.526001519587677318785587544488e-01;
@@ -218,27 +218,6 @@ const FAC_MAX: f64 = 6.0; // and grows by at most 6×
 const BETA: f64 = 0.0;
 const EXPO: f64 = 1.0 / 8.0 - 0.2 * BETA;
 const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
-
-/// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument). The slices are cut to `out.len()` first
-/// so the loops carry no bounds checks; the `M` terms are unrolled; the increments are summed
-/// before they are added to `base`, as in the textbook formula.
-#[inline(always)]
-fn combine<const M: usize>(out: &mut [f64], base: &[f64], h: f64, a: [f64; M], mut k: [&[f64]; M]) {
-    let n = out.len();
-    for kj in k.iter_mut() {
-        *kj = &kj[..n];
-    }
-    for (i, o) in out.iter_mut().enumerate() {
-        let mut acc = a[0] * k[0][i];
-        for j in 1..M {
-            acc += a[j] * k[j][i];
-        }
-        *o = h * acc;
-    }
-    for (o, &b) in out.iter_mut().zip(&base[..n]) {
-        *o += b;
-    }
-}
 
 /// When [`Dop853`] evaluates the dense-output stages of an accepted step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

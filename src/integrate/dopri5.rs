@@ -4,7 +4,7 @@
 //! J. Comput. Appl. Math. 6 (1980); dense-output coefficients and the PI controller as
 //! described in Hairer, Nørsett & Wanner, *Solving ODEs I* (2nd ed.), §II.4–II.6.
 
-use super::{OdeSystem, Stats, StepError, Stepper, Tolerances};
+use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine};
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -150,51 +150,54 @@ impl Dopri5 {
         let t = self.t;
         let n = self.y.len();
         let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        let (y, s) = (&self.y, &mut self.stage);
-        for i in 0..n {
-            s[i] = y[i] + h * A21 * k1[i];
+        let (y, s) = (&self.y[..], &mut self.stage[..]);
+        // Stage 2 as (h a₂₁) k₁, as it has always been rounded; the others through `combine`.
+        for (si, (&yi, &k1i)) in s.iter_mut().zip(y.iter().zip(&k1[..n])) {
+            *si = yi + h * A21 * k1i;
         }
         sys.rhs(t + C2 * h, s, k2);
-        for i in 0..n {
-            s[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i]);
-        }
+        combine(s, y, h, [A31, A32], [k1, k2]);
         sys.rhs(t + C3 * h, s, k3);
-        for i in 0..n {
-            s[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i]);
-        }
+        combine(s, y, h, [A41, A42, A43], [k1, k2, k3]);
         sys.rhs(t + C4 * h, s, k4);
-        for i in 0..n {
-            s[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i]);
-        }
+        combine(s, y, h, [A51, A52, A53, A54], [k1, k2, k3, k4]);
         sys.rhs(t + C5 * h, s, k5);
-        for i in 0..n {
-            s[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i]);
-        }
+        combine(s, y, h, [A61, A62, A63, A64, A65], [k1, k2, k3, k4, k5]);
         sys.rhs(t + h, s, k6);
-        let y_new = &mut self.y_new;
-        for i in 0..n {
-            y_new[i] =
-                y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i]);
-        }
+        let y_new = &mut self.y_new[..];
+        combine(y_new, y, h, [A71, A73, A74, A75, A76], [k1, k3, k4, k5, k6]);
         sys.rhs(t + h, y_new, k7);
         self.stats.rhs_evaluations += 6;
         let mut err = 0.0;
+        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
+        let (y_new, y) = (&y_new[..n], &y[..n]);
+        let (atol, rtol) = (self.tol.atol, self.tol.rtol);
         for i in 0..n {
             let e =
                 h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-            let sc = self.tol.atol + self.tol.rtol * y[i].abs().max(y_new[i].abs());
+            let sc = atol + rtol * y[i].abs().max(y_new[i].abs());
             err += (e / sc).powi(2);
         }
         (err / n as f64).sqrt()
     }
 
     fn store_dense_output(&mut self, h: f64) {
+        let n = self.y.len();
         let [k1, _, k3, k4, k5, k6, k7] = &self.k;
+        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
         let [c1, c2, c3, c4, c5] = &mut self.cont;
-        for i in 0..self.y.len() {
-            let dy = self.y_new[i] - self.y[i];
+        let (c1, c2, c3, c4, c5) = (
+            &mut c1[..n],
+            &mut c2[..n],
+            &mut c3[..n],
+            &mut c4[..n],
+            &mut c5[..n],
+        );
+        let (y, y_new) = (&self.y[..n], &self.y_new[..n]);
+        for i in 0..n {
+            let dy = y_new[i] - y[i];
             let bspl = h * k1[i] - dy;
-            c1[i] = self.y[i];
+            c1[i] = y[i];
             c2[i] = dy;
             c3[i] = bspl;
             c4[i] = dy - h * k7[i] - bspl;

@@ -182,3 +182,30 @@ pub struct Tolerances {
     /// Absolute tolerance (units of the state).
     pub atol: f64,
 }
+
+/// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument). The slices are cut to `out.len()` first
+/// so the loops carry no bounds checks; the `M` terms are unrolled; the increments are summed
+/// before they are added to `base`, as in the textbook formula.
+#[inline(always)]
+pub(crate) fn combine<const M: usize>(
+    out: &mut [f64],
+    base: &[f64],
+    h: f64,
+    a: [f64; M],
+    mut k: [&[f64]; M],
+) {
+    let n = out.len();
+    for kj in k.iter_mut() {
+        *kj = &kj[..n];
+    }
+    for (i, o) in out.iter_mut().enumerate() {
+        let mut acc = a[0] * k[0][i];
+        for j in 1..M {
+            acc += a[j] * k[j][i];
+        }
+        *o = h * acc;
+    }
+    for (o, &b) in out.iter_mut().zip(&base[..n]) {
+        *o += b;
+    }
+}
