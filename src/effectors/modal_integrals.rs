@@ -221,6 +221,11 @@ impl ShapeIntegrals {
         // (the â part of A_k contracted with W), for g over the φ and S features.
         let mut p = [[0.0; F]; C];
         let aa = axis.norm_squared();
+        // S_ij's feature index, in a fixed-size table (no bounds checks against the Vec).
+        let mut pair = [[0usize; NM]; NM];
+        for (i, row) in pair.iter_mut().enumerate().take(nm) {
+            row[..nm].copy_from_slice(&self.pair[i * nm..(i + 1) * nm]);
+        }
         for (d, t) in dirs.iter().enumerate() {
             let ta = t.dot(&axis);
             for i in 0..nm {
@@ -231,7 +236,7 @@ impl ShapeIntegrals {
                     let pk = &mut p[kk];
                     for j in 0..nm {
                         let c = -q[d * nm + j];
-                        let s = self.pair[i * nm + j];
+                        let s = pair[i][j];
                         let row = &wm[s * nf..(s + 1) * nf];
                         for g in 2..nf {
                             pk[g] += c * row[g];
@@ -248,7 +253,8 @@ impl ShapeIntegrals {
                 out.inertial[kk] = -(b[phi].dot(t) + bs.dot(&axis));
                 // M_kl = t̂_d·t̂_e W[φ_i, φ_j] + t̂_d·â P_l[φ_i] + â·t̂_e P_k[φ_j]
                 //        + â·â Σ_j' −q_ej' P_k[S_jj'],   for l = (e, j) ≤ k.
-                for (e, te) in dirs.iter().enumerate().take(d + 1) {
+                for e in 0..=d {
+                    let te = &dirs[e];
                     let tt = t.dot(te);
                     let ea = te.dot(&axis);
                     let last = if e == d { i + 1 } else { nm };
@@ -258,7 +264,7 @@ impl ShapeIntegrals {
                         if stiff {
                             let mut ss = 0.0;
                             for jj in 0..nm {
-                                ss += -q[e * nm + jj] * p[kk][self.pair[j * nm + jj]];
+                                ss += -q[e * nm + jj] * p[kk][pair[j][jj]];
                             }
                             m += ta * p[l][phi] + ea * p[kk][2 + j] + aa * ss;
                         }
@@ -272,6 +278,7 @@ impl ShapeIntegrals {
     /// The coefficients A_r, A_v and A_κ at `q` and `u` (`NM` and `F` as in
     /// [`ShapeIntegrals::sizes`]).
     #[allow(clippy::type_complexity)]
+    #[inline(always)]
     fn coefficients<const NM: usize, const F: usize>(
         &self,
         geometry: &Geometry,
