@@ -732,8 +732,8 @@ impl Spacecraft {
     }
 
     /// The hub's equations with every effector's terms added, at state `y`, written into
-    /// `coupling` (zero on entry: built in place, as a returned value it was copied);
-    /// effectors leave their intermediate results in `scratch`. With `free_hub` (the hub's
+    /// `coupling` (zero on entry; filled in place because returning it by value cost a copy
+    /// of some 0.3 kB per call); effectors leave their intermediate results in `scratch`. With `free_hub` (the hub's
     /// translation free and solved for), a lone mass-moving effector may eliminate that
     /// translation itself ([`Effector::couple_alone`]), and the coupling then has
     /// `translation` false.
