@@ -797,8 +797,9 @@ impl Spacecraft {
             }
         }
         // Effectors add to the lower triangle only (the mass matrix is symmetric). The solves
-        // read the lower triangle alone, but a build without this copy computed wrong
-        // accelerations in one scene (docs/benchmarks.md, "A copy that must stay").
+        // read the lower triangle alone; the copy stays for the fallbacks, and because a
+        // release build without it computed wrong accelerations in one scene
+        // (docs/benchmarks.md, "Wrong accelerations from some release builds").
         for i in 0..6 {
             for j in 0..i {
                 coupling.mass[(j, i)] = coupling.mass[(i, j)];
@@ -988,8 +989,10 @@ fn spd_inverse3(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Option<Matrix
 /// translational one z_t = A⁻¹ f_t − Xᵀ z_r. Both 3 × 3 inverses are closed-form (cofactors),
 /// so the solve is straight-line code: no loops, no square roots, two reciprocals
 /// (a 6 × 6 L D Lᵀ with loops was a tenth of Explorer 1's right-hand side). `None` when
-/// `m` is not positive definite (A or S is not).
-#[inline]
+/// `m` is not positive definite (A or S is not). Kept out of line: inlined, some release
+/// builds computed wrong accelerations in one scene (docs/benchmarks.md, "Wrong accelerations
+/// from some release builds"); the call costs about 1% of Explorer 1's instructions.
+#[inline(never)]
 fn schur_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
     let a_inv = spd_inverse3(
         m[(0, 0)],
