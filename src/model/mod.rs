@@ -524,11 +524,6 @@ impl Spacecraft {
                     effector.name()
                 )));
             }
-            self.alone = if self.translation {
-                None
-            } else {
-                Some(self.effectors.len())
-            };
             self.translation = true;
         }
         if effector.acts_on_moving_masses() {
@@ -549,6 +544,7 @@ impl Spacecraft {
         self.scratch_lens.push(effector.scratch_len());
         self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
+        self.alone = lone_mover(&self.effectors);
         self.groups = crate::effectors::rod_lanes::RodLanes::groups(&self.effectors, &self.offsets)
             .into_iter()
             .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
@@ -575,13 +571,7 @@ impl Spacecraft {
     /// one.
     #[cfg(test)]
     pub(crate) fn couple_alone_effector(&mut self, on: bool) {
-        let movers: Vec<usize> = (0..self.effectors.len())
-            .filter(|&k| self.effectors[k].moves_mass())
-            .collect();
-        self.alone = match movers[..] {
-            [k] if on => Some(k),
-            _ => None,
-        };
+        self.alone = lone_mover(&self.effectors).filter(|_| on);
     }
 
     /// Prescribes the hub's rotation (its centre of mass is then pinned in inertial space).
@@ -955,6 +945,19 @@ impl Spacecraft {
         });
         dydt[..3].copy_from_slice(omega_dot.as_slice());
         quaternion_rate(&y[3..7], &omega, &mut dydt[3..7]);
+    }
+}
+
+/// The index of the one effector that moves mass, when exactly one does.
+fn lone_mover(effectors: &[Box<dyn Effector>]) -> Option<usize> {
+    let mut movers = effectors
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.moves_mass())
+        .map(|(k, _)| k);
+    match (movers.next(), movers.next()) {
+        (Some(k), None) => Some(k),
+        _ => None,
     }
 }
 
