@@ -95,26 +95,22 @@ impl ModalBeam {
         r
     }
 
-    /// The bending directions as an array (`None` past two).
-    fn directions(&self) -> Option<([Vector3<f64>; 2], usize)> {
-        let mut directions = [Vector3::zeros(); 2];
-        if self.bending.len() > directions.len() {
+    /// The geometry the shape integrals are contracted with (`None` past two bending
+    /// directions). (Built in place: a copy of the directions assembled piece by piece and
+    /// read back whole stalls the store forwarding of some processors.)
+    fn geometry(&self) -> Option<Geometry> {
+        let count = self.bending.len();
+        if count > 2 {
             return None;
         }
-        for (d, (_, t)) in self.bending.iter().enumerate() {
-            directions[d] = *t;
-        }
-        Some((directions, self.bending.len()))
-    }
-
-    /// The geometry the shape integrals are contracted with.
-    fn geometry<'a>(&self, directions: &'a ([Vector3<f64>; 2], usize)) -> Geometry<'a> {
-        Geometry {
+        let direction = |d: usize| self.bending.get(d).map_or_else(Vector3::zeros, |b| b.1);
+        Some(Geometry {
             attachment: self.attachment,
             axis: self.axis,
-            directions: &directions.0[..directions.1],
+            directions: [direction(0), direction(1)],
+            count,
             stiffening: self.geometric_stiffening,
-        }
+        })
     }
 
     /// Tip deflection along each bending direction (m).
@@ -237,16 +233,15 @@ impl ParticleModel for ModalBeam {
         omega: &Vector3<f64>,
         out: &mut ParticleSums<N>,
     ) -> bool {
-        let (Some(integrals), Some(directions)) = (&self.integrals, self.directions()) else {
+        let (Some(integrals), Some(geometry)) = (&self.integrals, self.geometry()) else {
             return false;
         };
-        integrals.sums(&self.geometry(&directions), q, u, omega, out);
+        integrals.sums(&geometry, q, u, omega, out);
         true
     }
     fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
         let integrals = self.integrals.as_ref()?;
-        let directions = self.directions()?;
-        let geometry = self.geometry(&directions);
+        let geometry = self.geometry()?;
         Some(integrals.momentum(&geometry, q, u, omega))
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {

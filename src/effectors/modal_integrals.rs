@@ -73,20 +73,28 @@ pub(crate) struct ShapeIntegrals {
     features: usize,
     /// W, F × F row-major, symmetric.
     moments: Vec<f64>,
-    /// Feature index of S_ij (and S_ji), N × N row-major.
-    pair: Vec<usize>,
 }
 
 /// The beam's geometry in body axes, as [`super::modal::ModalBeam`] holds it.
-pub(crate) struct Geometry<'a> {
+pub(crate) struct Geometry {
     /// Root point p₀ (m).
     pub attachment: Vector3<f64>,
     /// Unit beam axis â.
     pub axis: Vector3<f64>,
-    /// Bending directions t̂_d (one or two).
-    pub directions: &'a [Vector3<f64>],
+    /// Bending directions t̂_d: the first [`Geometry::count`] (one or two).
+    pub directions: [Vector3<f64>; 2],
+    /// Number of bending directions.
+    pub count: usize,
     /// Whether the foreshortening is modelled.
     pub stiffening: bool,
+}
+
+/// Feature index of S_ij (= S_ji) among the F features of N modes: they follow the N mode
+/// shapes, row by row of the upper triangle i ≤ j.
+#[inline(always)]
+fn pair_feature(modes: usize, i: usize, j: usize) -> usize {
+    let (i, j) = if i <= j { (i, j) } else { (j, i) };
+    2 + modes + i * modes - i * i.saturating_sub(1) / 2 - i + j
 }
 
 impl ShapeIntegrals {
@@ -97,15 +105,6 @@ impl ShapeIntegrals {
             return None;
         }
         let features = 2 + n + n * (n + 1) / 2;
-        let mut pair = vec![0; n * n];
-        let mut next = 2 + n;
-        for i in 0..n {
-            for j in i..n {
-                pair[i * n + j] = next;
-                pair[j * n + i] = next;
-                next += 1;
-            }
-        }
         let mut moments = vec![0.0; features * features];
         let mut f = vec![0.0; features];
         for node in modes.nodes.iter().filter(|node| node.mass > 0.0) {
@@ -114,7 +113,7 @@ impl ShapeIntegrals {
             f[2..2 + n].copy_from_slice(&node.phi[..n]);
             for i in 0..n {
                 for j in i..n {
-                    f[pair[i * n + j]] = node.shortening[i * n + j];
+                    f[pair_feature(n, i, j)] = node.shortening[i * n + j];
                 }
             }
             for a in 0..features {
@@ -128,7 +127,6 @@ impl ShapeIntegrals {
             modes: n,
             features,
             moments,
-            pair,
         })
     }
 
@@ -178,7 +176,7 @@ impl ShapeIntegrals {
         out: &mut ParticleSums<N>,
     ) {
         let (nm, nf) = self.sizes::<NM, F>();
-        let dirs = geometry.directions;
+        let dirs = &geometry.directions[..geometry.count];
         let axis = geometry.axis;
         let w = omega;
         let stiff = geometry.stiffening;
@@ -221,11 +219,8 @@ impl ShapeIntegrals {
         // (the â part of A_k contracted with W), for g over the φ and S features.
         let mut p = [[0.0; F]; C];
         let aa = axis.norm_squared();
-        // S_ij's feature index, in a fixed-size table (no bounds checks against the Vec).
-        let mut pair = [[0usize; NM]; NM];
-        for (i, row) in pair.iter_mut().enumerate().take(nm) {
-            row[..nm].copy_from_slice(&self.pair[i * nm..(i + 1) * nm]);
-        }
+        // S_ij's feature index (constants once the loops over NM modes are unrolled).
+        let pair = |i: usize, j: usize| pair_feature(nm, i, j);
         for (d, t) in dirs.iter().enumerate() {
             let ta = t.dot(&axis);
             for i in 0..nm {
@@ -236,7 +231,7 @@ impl ShapeIntegrals {
                     let pk = &mut p[kk];
                     for j in 0..nm {
                         let c = -q[d * nm + j];
-                        let s = pair[i][j];
+                        let s = pair(i, j);
                         let row = &wm[s * nf..(s + 1) * nf];
                         for g in 2..nf {
                             pk[g] += c * row[g];
@@ -264,7 +259,7 @@ impl ShapeIntegrals {
                         if stiff {
                             let mut ss = 0.0;
                             for jj in 0..nm {
-                                ss += -q[e * nm + jj] * p[kk][pair[j][jj]];
+                                ss += -q[e * nm + jj] * p[kk][pair(j, jj)];
                             }
                             m += ta * p[l][phi] + ea * p[kk][2 + j] + aa * ss;
                         }
@@ -286,7 +281,7 @@ impl ShapeIntegrals {
         u: &[f64],
     ) -> ([Vector3<f64>; F], [Vector3<f64>; F], [Vector3<f64>; F]) {
         let (nm, _) = self.sizes::<NM, F>();
-        let dirs = geometry.directions;
+        let dirs = &geometry.directions[..geometry.count];
         let axis = geometry.axis;
         let mut a_r = [Vector3::zeros(); F];
         let mut a_v = [Vector3::zeros(); F];
@@ -316,7 +311,7 @@ impl ShapeIntegrals {
                     } else {
                         gk *= 2.0;
                     }
-                    let s = self.pair[i * nm + j];
+                    let s = pair_feature(nm, i, j);
                     a_r[s] = -gq * axis;
                     a_v[s] = -gv * axis;
                     a_k[s] = -gk * axis;
@@ -437,6 +432,22 @@ mod tests {
             .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
         assert!(scale > 0.0);
         diff / scale
+    }
+
+    #[test]
+    fn each_mode_pair_has_its_own_feature_after_the_mode_shapes() {
+        for n in 1..=MAX_MODES {
+            let features = 2 + n + n * (n + 1) / 2;
+            let mut next = 2 + n;
+            for i in 0..n {
+                for j in i..n {
+                    assert_eq!(pair_feature(n, i, j), next, "N = {n}, S_{i}{j}");
+                    assert_eq!(pair_feature(n, j, i), next, "N = {n}, S_{j}{i}");
+                    next += 1;
+                }
+            }
+            assert_eq!(next, features);
+        }
     }
 
     #[test]
