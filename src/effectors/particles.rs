@@ -238,25 +238,32 @@ impl<P: ParticleModel> ParticleEffector<P> {
     }
 }
 
-/// In-place Cholesky factor L (M = L Lᵀ) of the leading n × n block of `a`, lower triangle
-/// read and written, with the reciprocals of L's diagonal stored on the diagonal; returns
-/// false if not positive definite. (Indexed loops, as the algorithm is written.)
+/// In-place factors M = L D Lᵀ (L unit lower triangular, D diagonal) of the leading n × n
+/// block of `a`, lower triangle read and written: L below the diagonal, the reciprocals of D
+/// on it; returns false if not positive definite. Cholesky's factor is L D^½, but this needs
+/// no square roots: one division per pivot, on the factorisation's critical path. (Indexed
+/// loops, as the algorithm is written.)
 #[allow(clippy::needless_range_loop)]
-fn cholesky<const N: usize>(a: &mut [[f64; N]; N], n: usize) -> bool {
+fn ldl<const N: usize>(a: &mut [[f64; N]; N], n: usize) -> bool {
+    let mut diagonal = [0.0; N];
     for j in 0..n {
+        // Row j of L D: l_jk d_k (k < j).
+        let mut ld = [0.0; N];
         let mut d = a[j][j];
         for k in 0..j {
-            d -= a[j][k] * a[j][k];
+            ld[k] = a[j][k] * diagonal[k];
+            d -= ld[k] * a[j][k];
         }
         if d.is_nan() || d <= 0.0 {
             return false;
         }
-        let r = 1.0 / d.sqrt();
+        diagonal[j] = d;
+        let r = 1.0 / d;
         a[j][j] = r;
         for i in j + 1..n {
             let mut s = a[i][j];
             for k in 0..j {
-                s -= a[i][k] * a[j][k];
+                s -= a[i][k] * ld[k];
             }
             a[i][j] = s * r;
         }
@@ -265,7 +272,8 @@ fn cholesky<const N: usize>(a: &mut [[f64; N]; N], n: usize) -> bool {
 }
 
 /// Solves L X = B in place (forward substitution) for the 7 columns of the first n rows of
-/// `b`, with `l` from [`cholesky`]. (Indexed loops, as the algorithm is written.)
+/// `b`, with the unit lower triangular L from [`ldl`]. (Indexed loops, as the algorithm is
+/// written.)
 #[allow(clippy::needless_range_loop)]
 fn forward7<const N: usize>(l: &[[f64; N]; N], n: usize, b: &mut [[f64; 7]; N]) {
     for i in 0..n {
@@ -274,10 +282,6 @@ fn forward7<const N: usize>(l: &[[f64; N]; N], n: usize, b: &mut [[f64; 7]; N]) 
             for c in 0..7 {
                 b[i][c] -= lik * b[k][c];
             }
-        }
-        let r = l[i][i];
-        for c in 0..7 {
-            b[i][c] *= r;
         }
     }
 }
@@ -376,16 +380,17 @@ impl<P: ParticleModel> ParticleEffector<P> {
         let ct = &sums.coupling;
         let kept = &mut scratch[..7 * n + n * (n + 1) / 2];
         let (kept_w, kept_l) = kept.split_at_mut(7 * n);
-        // The coordinates' elimination: C M⁻¹ Cᵀ = Σ_k left_kᵀ right_k (the last 6 of the 7)
-        // and C M⁻¹ g = Σ_k left_kᵀ right_k0, and `derivatives` finishes
-        // u̇ = L⁻ᵀ (W_g − W_C z) from W (row-major, stride 7) and L (packed, reciprocal
-        // diagonal) kept in the scratch.
+        // The coordinates' elimination, with M = L D Lᵀ (L unit lower triangular) and
+        // W = D⁻¹ L⁻¹ [g | Cᵀ]: C M⁻¹ Cᵀ = Σ_k left_kᵀ right_k (the last 6 of the 7) and
+        // C M⁻¹ g = Σ_k left_kᵀ right_k0, with right_k = W_k and left_k = (L⁻¹ Cᵀ)_k; and
+        // `derivatives` finishes u̇ = L⁻ᵀ (W_g − W_C z) from W (row-major, stride 7) and L
+        // (packed, unit diagonal) kept in the scratch.
         let mut left = [[0.0; 6]; N];
         let mut right = [[0.0; 7]; N];
         let diagonal = (1..n).all(|k| mass[k][..k].iter().all(|&v| v == 0.0));
         let definite = if diagonal {
             // M diagonal (one coordinate, or kinematics with orthogonal Jacobian columns):
-            // L = 1 and W = M⁻¹ [g | Cᵀ], and left = Cᵀ. No square roots.
+            // L = 1, D = M: W = M⁻¹ [g | Cᵀ], and left = Cᵀ.
             kept_l.fill(0.0);
             let mut definite = true;
             for k in 0..n {
@@ -400,9 +405,9 @@ impl<P: ParticleModel> ParticleEffector<P> {
                 kept_l[packed(k, k)] = 1.0;
             }
             definite
-        } else if cholesky(mass, n) {
-            // M = L Lᵀ: W = L⁻¹ [g | Cᵀ] (n × 7), one forward substitution with 7 columns,
-            // and left = W_C.
+        } else if ldl(mass, n) {
+            // L⁻¹ [g | Cᵀ] (n × 7) by one forward substitution with 7 columns; its last six
+            // columns are left, and D⁻¹ times it is W.
             for k in 0..n {
                 right[k][0] = g[k];
                 right[k][1..].copy_from_slice(&ct[k]);
@@ -410,7 +415,12 @@ impl<P: ParticleModel> ParticleEffector<P> {
             forward7(mass, n, &mut right);
             for k in 0..n {
                 left[k].copy_from_slice(&right[k][1..]);
-                kept_l[packed(k, 0)..=packed(k, k)].copy_from_slice(&mass[k][..=k]);
+                let r = mass[k][k];
+                for v in right[k].iter_mut() {
+                    *v *= r;
+                }
+                kept_l[packed(k, 0)..packed(k, k)].copy_from_slice(&mass[k][..k]);
+                kept_l[packed(k, k)] = 1.0;
             }
             true
         } else {
@@ -427,11 +437,16 @@ impl<P: ParticleModel> ParticleEffector<P> {
             kept_w[k * 7..k * 7 + 7].copy_from_slice(&right[k]);
         }
         // mass −= C M⁻¹ Cᵀ (lower triangle); force −= C M⁻¹ g.
+        // (On the matrices' arrays, column by column, with fixed bounds: no index checks.)
+        let mass_columns = &mut coupling.mass.data.0;
         for (lk, rk) in left[..n].iter().zip(&right[..n]) {
-            for (a, &lka) in lk.iter().enumerate() {
+            for a in 0..6 {
+                let lka = lk[a];
                 coupling.force[a] -= lka * rk[0];
-                for (b, &rkb) in rk[1..=a + 1].iter().enumerate() {
-                    coupling.mass[(a, b)] -= lka * rkb;
+                for b in 0..6 {
+                    if b <= a {
+                        mass_columns[b][a] -= lka * rk[1 + b];
+                    }
                 }
             }
         }
@@ -717,20 +732,20 @@ mod tests {
 
     #[test]
     #[allow(clippy::needless_range_loop)] // the matrix identities, index by index
-    fn cholesky_and_its_substitutions_solve_a_small_system() {
+    fn ldl_and_its_substitutions_solve_a_small_system() {
         let m = [[4.0, 2.0, 0.6], [2.0, 5.0, 1.0], [0.6, 1.0, 3.0]];
         // In a larger array: only the leading 3 × 3 block is used.
         let mut a = [[0.0; 4]; 4];
         for (i, row) in m.iter().enumerate() {
             a[i][..3].copy_from_slice(row);
         }
-        assert!(cholesky(&mut a, 3));
-        // L Lᵀ = M, with L's diagonal stored as reciprocals.
-        let entry = |i: usize, j: usize| if i == j { 1.0 / a[i][i] } else { a[i][j] };
+        assert!(ldl(&mut a, 3));
+        // L D Lᵀ = M, with L's unit diagonal implied and D's stored as reciprocals.
+        let entry = |i: usize, j: usize| if i == j { 1.0 } else { a[i][j] };
         for i in 0..3 {
             for j in 0..=i {
-                let llt: f64 = (0..=j).map(|k| entry(i, k) * entry(j, k)).sum();
-                assert!((llt - m[i][j]).abs() < 1e-14, "({i}, {j}): {llt}");
+                let ldlt: f64 = (0..=j).map(|k| entry(i, k) * entry(j, k) / a[k][k]).sum();
+                assert!((ldlt - m[i][j]).abs() < 1e-14, "({i}, {j}): {ldlt}");
             }
         }
         // L W = B column by column.
@@ -746,7 +761,7 @@ mod tests {
             }
         }
         let mut singular = [[0.0; 2]; 2];
-        assert!(!cholesky(&mut singular, 2));
+        assert!(!ldl(&mut singular, 2));
     }
 
     /// A model's closed-form sums and momentum equal the particle sums to rounding, at states
