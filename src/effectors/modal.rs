@@ -98,6 +98,7 @@ impl ModalBeam {
     /// The geometry the shape integrals are contracted with (`None` past two bending
     /// directions). (Built in place: a copy of the directions assembled piece by piece and
     /// read back whole stalls the store forwarding of some processors.)
+    #[inline(always)]
     fn geometry(&self) -> Option<Geometry> {
         let count = self.bending.len();
         if count > 2 {

@@ -140,15 +140,29 @@ impl ShapeIntegrals {
         omega: &Vector3<f64>,
         out: &mut ParticleSums<N>,
     ) {
-        // Compiled for one to four modes (fixed loop bounds), and for any number up to ten.
+        // Compiled for one to four modes in two directions (fixed loop bounds), and for any
+        // number of modes up to ten in one or two.
+        let two = geometry.count == 2;
         match self.modes {
-            1 => self.sums_sized::<1, 4, 2, N>(geometry, q, u, omega, out),
-            2 => self.sums_sized::<2, 7, 4, N>(geometry, q, u, omega, out),
-            3 => self.sums_sized::<3, 11, 6, N>(geometry, q, u, omega, out),
-            4 => self.sums_sized::<4, 16, 8, N>(geometry, q, u, omega, out),
-            _ => self.sums_sized::<MAX_MODES, MAX_FEATURES, MAX_BEAM_COORDINATES, N>(
+            1 if two => self.sums_sized::<1, 4, 2, 2, N>(geometry, q, u, omega, out),
+            2 if two => self.sums_sized::<2, 7, 4, 2, N>(geometry, q, u, omega, out),
+            3 if two => self.sums_sized::<3, 11, 6, 2, N>(geometry, q, u, omega, out),
+            4 if two => self.sums_sized::<4, 16, 8, 2, N>(geometry, q, u, omega, out),
+            _ => self.sums_sized::<MAX_MODES, MAX_FEATURES, MAX_BEAM_COORDINATES, 0, N>(
                 geometry, q, u, omega, out,
             ),
+        }
+    }
+
+    /// The number of bending directions: `ND` when it is not zero (a constant), the
+    /// geometry's own otherwise.
+    #[inline(always)]
+    fn directions<const ND: usize>(geometry: &Geometry) -> &[Vector3<f64>] {
+        if ND > 0 {
+            debug_assert_eq!(geometry.count, ND);
+            &geometry.directions[..ND]
+        } else {
+            &geometry.directions[..geometry.count]
         }
     }
 
@@ -164,10 +178,17 @@ impl ShapeIntegrals {
     }
 
     /// [`ShapeIntegrals::sums`] for `NM` modes and `F` features (see
-    /// [`ShapeIntegrals::sizes`]), `C` ≥ 2 `NM` coordinates, written into `out` (zero on
-    /// entry). (Indexed loops, as the formulas are written.)
+    /// [`ShapeIntegrals::sizes`]), `C` ≥ 2 `NM` coordinates and `ND` directions (see
+    /// [`ShapeIntegrals::directions`]), written into `out` (zero on entry). (Indexed loops,
+    /// as the formulas are written.)
     #[allow(clippy::needless_range_loop)]
-    fn sums_sized<const NM: usize, const F: usize, const C: usize, const N: usize>(
+    fn sums_sized<
+        const NM: usize,
+        const F: usize,
+        const C: usize,
+        const ND: usize,
+        const N: usize,
+    >(
         &self,
         geometry: &Geometry,
         q: &[f64],
@@ -176,14 +197,14 @@ impl ShapeIntegrals {
         out: &mut ParticleSums<N>,
     ) {
         let (nm, nf) = self.sizes::<NM, F>();
-        let dirs = &geometry.directions[..geometry.count];
+        let dirs = Self::directions::<ND>(geometry);
         let axis = geometry.axis;
         let w = omega;
         let stiff = geometry.stiffening;
         let wm = &self.moments[..nf * nf];
         // Coefficients of position, relative velocity, κ and c (without stiffening the S_ij
         // ones are zero, and so are their products below).
-        let (a_r, a_v, a_k) = self.coefficients::<NM, F>(geometry, q, u);
+        let (a_r, a_v, a_k) = self.coefficients::<NM, F, ND>(geometry, q, u);
         let mut a_c = [Vector3::zeros(); F];
         // ω × (ω × a) = ω (ω·a) − a ω².
         let w2 = w.norm_squared();
@@ -274,14 +295,14 @@ impl ShapeIntegrals {
     /// [`ShapeIntegrals::sizes`]).
     #[allow(clippy::type_complexity)]
     #[inline(always)]
-    fn coefficients<const NM: usize, const F: usize>(
+    fn coefficients<const NM: usize, const F: usize, const ND: usize>(
         &self,
         geometry: &Geometry,
         q: &[f64],
         u: &[f64],
     ) -> ([Vector3<f64>; F], [Vector3<f64>; F], [Vector3<f64>; F]) {
         let (nm, _) = self.sizes::<NM, F>();
-        let dirs = &geometry.directions[..geometry.count];
+        let dirs = Self::directions::<ND>(geometry);
         let axis = geometry.axis;
         let mut a_r = [Vector3::zeros(); F];
         let mut a_v = [Vector3::zeros(); F];
@@ -352,7 +373,7 @@ impl ShapeIntegrals {
     ) -> Momentum {
         let (_, nf) = self.sizes::<NM, F>();
         let wm = &self.moments[..nf * nf];
-        let (a_r, a_v, _) = self.coefficients::<NM, F>(geometry, q, u);
+        let (a_r, a_v, _) = self.coefficients::<NM, F, 0>(geometry, q, u);
         let mut a_w = [Vector3::zeros(); F];
         for f in 0..nf {
             a_w[f] = omega.cross(&a_r[f]) + a_v[f];
