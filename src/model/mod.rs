@@ -472,8 +472,15 @@ pub struct Spacecraft {
     /// The one effector that moves mass, when there is exactly one: it may eliminate the
     /// hub's translation itself ([`Effector::couple_alone`]).
     alone: Option<usize>,
+    /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient
+    /// and a scratch of at most [`LONE_SCRATCH`] numbers: the right-hand side then takes
+    /// [`Spacecraft::lone_rhs`].
+    lone_only: bool,
     dim: usize,
 }
+
+/// The largest scratch [`Spacecraft::lone_rhs`] keeps on the stack (numbers).
+const LONE_SCRATCH: usize = 8;
 
 impl Spacecraft {
     /// A rigid spacecraft with no effectors. `spin_axis` is normalised here.
@@ -503,6 +510,7 @@ impl Spacecraft {
             group_scratch: Vec::new(),
             tidal_source: None,
             alone: None,
+            lone_only: false,
             dim: HUB_STATES,
         }
     }
@@ -563,7 +571,17 @@ impl Spacecraft {
                 Some(range)
             })
             .collect();
+        self.lone_only = self.only_the_lone_mover();
         Ok(())
+    }
+
+    /// See [`Spacecraft::lone_only`].
+    fn only_the_lone_mover(&self) -> bool {
+        self.alone == Some(0)
+            && self.effectors.len() == 1
+            && self.groups.is_empty()
+            && self.tidal_source.is_none()
+            && self.scratch_len <= LONE_SCRATCH
     }
 
     /// Whether a lone mass-moving effector may eliminate the hub's translation itself
@@ -572,6 +590,7 @@ impl Spacecraft {
     #[cfg(test)]
     pub(crate) fn couple_alone_effector(&mut self, on: bool) {
         self.alone = lone_mover(&self.effectors).filter(|_| on);
+        self.lone_only = self.only_the_lone_mover();
     }
 
     /// Prescribes the hub's rotation (its centre of mass is then pinned in inertial space).
@@ -849,6 +868,61 @@ impl Spacecraft {
         accel.angular
     }
 
+    /// Right-hand side of a scene whose one effector moves mass and eliminates the hub's
+    /// translation itself ([`Spacecraft::lone_only`]): the same arithmetic as
+    /// [`Spacecraft::effector_rhs`] with [`solve_hub`], without the loops over effectors and
+    /// groups, the thread-local scratch (its scratch is on the stack) and the 6 × 6 matrix's
+    /// translational rows. Writes the whole of `dydt` and returns true, or returns false
+    /// having written nothing when the effector has no such form after all
+    /// ([`Effector::couple_alone`] false). Out of line, so that the other scenes'
+    /// right-hand sides compile as before.
+    #[inline(never)]
+    fn lone_rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) -> bool {
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let hub = HubState {
+            t,
+            omega,
+            attitude: &y[3..7],
+        };
+        let mut coupling = HubCoupling {
+            mass: Matrix6::zeros(),
+            force: Vector6::zeros(),
+            translation: false,
+            tidal: None,
+        };
+        coupling
+            .mass
+            .fixed_view_mut::<3, 3>(3, 3)
+            .copy_from(&self.hub.inertia);
+        let gyro = -omega.cross(&(self.hub.inertia * omega));
+        coupling.force[3] = gyro[0];
+        coupling.force[4] = gyro[1];
+        coupling.force[5] = gyro[2];
+        let (off, n) = (self.offsets[0], self.lens[0]);
+        let x = &y[off..off + n];
+        let mut scratch = [0.0; LONE_SCRATCH];
+        let scratch = &mut scratch[..self.scratch_len];
+        let effector = &self.effectors[0];
+        let hub_mass = self.hub_mass.unwrap_or(f64::NAN);
+        if !effector.couple_alone(&hub, hub_mass, x, &mut coupling, scratch) {
+            return false;
+        }
+        // The rotational block's upper triangle, for the solve's fallback.
+        for i in 4..6 {
+            for j in 3..i {
+                coupling.mass[(j, i)] = coupling.mass[(i, j)];
+            }
+        }
+        let accel = solve_hub(&coupling);
+        effector.derivatives(&hub, &accel, x, scratch, &mut dydt[off..off + n]);
+        let hub_dy = &mut dydt[..HUB_STATES];
+        hub_dy[0] = accel.angular[0];
+        hub_dy[1] = accel.angular[1];
+        hub_dy[2] = accel.angular[2];
+        quaternion_rate(&y[3..7], &omega, &mut hub_dy[3..7]);
+        true
+    }
+
     /// Right-hand side with the hub's accelerations taken from `solve(coupling)`.
     #[inline(always)]
     fn effector_rhs(
@@ -1083,6 +1157,9 @@ impl OdeSystem for Spacecraft {
         if let Some(motion) = &self.motion {
             let wd = motion.omega_dot(t);
             self.rhs_prescribed(t, y, &wd, false, dydt);
+            return;
+        }
+        if self.lone_only && self.lone_rhs(t, y, dydt) {
             return;
         }
         let omega = Vector3::new(y[0], y[1], y[2]);
