@@ -32,12 +32,20 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 use std::ops::Range;
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Runs a campaign runs in parallel before their rows are written: the most rows it holds.
 /// Each block ends when its slowest run does, which costs at most about one run's time per
 /// thread and block.
 pub const BLOCK_RUNS: u64 = 4096;
+
+/// Most runs per thread in a block for which the runs are ordered by their expected cost
+/// (see `Prepared::longest_first`).
+pub const ORDERED_RUNS_PER_THREAD: usize = 32;
+
+/// A run as [`Prepared::build_run`] builds it.
+type Built = Result<(Scenario, Vec<f64>), InvalidDraw>;
 
 /// A campaign ready to run: the nominal scenario, its tree, the checked campaign and the
 /// table's columns.
@@ -360,8 +368,13 @@ impl Prepared {
 
     /// Runs `i` to the end; `None` if it was interrupted (it is then not part of the result).
     pub fn run_one(&self, i: u64, interrupt: &AtomicBool) -> Option<Row> {
+        self.run_built(i, self.build_run(i), interrupt)
+    }
+
+    /// [`Prepared::run_one`] with run `i` already built (by [`Prepared::build_run`]).
+    fn run_built(&self, i: u64, built: Built, interrupt: &AtomicBool) -> Option<Row> {
         let mut values = vec![None; self.columns.len()];
-        let (sc, inputs) = match self.build_run(i) {
+        let (sc, inputs) = match built {
             Ok(x) => x,
             Err(InvalidDraw { message, inputs }) => {
                 // Keep what was drawn, so the table shows which draw was invalid.
@@ -488,26 +501,43 @@ impl Prepared {
         let mut partial = false;
         let mut start = range.start;
         while start < range.end {
+            if interrupt.load(Ordering::Relaxed) {
+                // The remaining blocks are skipped whole.
+                partial = true;
+                break;
+            }
             let block = start..(start + BLOCK_RUNS).min(range.end);
             start = block.end;
-            let results: Vec<Option<Row>> = pool.install(|| {
-                // One run per task (rayon would otherwise hand each thread a contiguous chunk
-                // of runs, and a long run late in one chunk leaves the other thread idle):
-                // a thread that runs out steals the next single run.
-                (0..(block.end - block.start) as usize)
-                    .into_par_iter()
-                    .with_max_len(1)
-                    .map(|j| {
-                        let i = block.start + j as u64;
-                        if interrupt.load(Ordering::Relaxed) {
-                            return None;
-                        }
-                        let row = self.run_one(i, interrupt)?;
+            let n = (block.end - block.start) as usize;
+            let (order, built) = self.longest_first(block.clone(), &pool, interrupt);
+            // A list schedule: each thread takes the next run of `order` as it finishes one,
+            // so that the longest runs start first and the short ones fill in at the end (a
+            // run's row does not depend on when or where it runs).
+            let next = AtomicUsize::new(0);
+            let slots: Vec<Mutex<Option<Row>>> = (0..n).map(|_| Mutex::new(None)).collect();
+            pool.broadcast(|_| {
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    if k >= n || interrupt.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let j = order[k];
+                    let i = block.start + j as u64;
+                    // The run as the prediction built it, if it did.
+                    let prebuilt = built
+                        .get(j)
+                        .and_then(|b| b.lock().unwrap_or_else(|e| e.into_inner()).take());
+                    let run =
+                        self.run_built(i, prebuilt.unwrap_or_else(|| self.build_run(i)), interrupt);
+                    if let Some(row) = run {
                         on_row(&row);
-                        Some(row)
-                    })
-                    .collect()
+                        *slots[j].lock().unwrap_or_else(|e| e.into_inner()) = Some(row);
+                    }
+                }
             });
+            let results = slots
+                .into_iter()
+                .map(|slot| slot.into_inner().unwrap_or_else(|e| e.into_inner()));
             for r in results {
                 match r {
                     Some(r) => consume(r)?,
@@ -516,6 +546,59 @@ impl Prepared {
             }
         }
         Ok(partial)
+    }
+
+    /// The runs of `range` (offsets into it), the longest expected first: by the stiffness of
+    /// each run's equations at its initial state (the spectral radius of the Jacobian, which
+    /// bounds an explicit method's step, times the duration), computed on `pool`. Runs
+    /// whose draw is invalid keep their index order after the others; so do all runs once
+    /// `interrupt` is set. In index order, without a prediction: the averaged method's runs
+    /// (whose cost is their slow steps), one thread, and more than [`ORDERED_RUNS_PER_THREAD`]
+    /// runs per thread, where the last runs' imbalance is small against the whole, and the
+    /// built runs would have to be held for the whole block.
+    /// Returns the order and, when it predicted, each run as it built it (taken by the runs,
+    /// so that none is built twice).
+    fn longest_first(
+        &self,
+        range: Range<u64>,
+        pool: &rayon::ThreadPool,
+        interrupt: &AtomicBool,
+    ) -> (Vec<usize>, Vec<Mutex<Option<Built>>>) {
+        let n = (range.end - range.start) as usize;
+        let averaged = matches!(
+            self.scenario.simulation.method,
+            crate::sim::Method::Averaged(_)
+        );
+        let threads = pool.current_num_threads();
+        if averaged || n < 2 || threads < 2 || n > ORDERED_RUNS_PER_THREAD * threads {
+            return ((0..n).collect(), Vec::new());
+        }
+        let predicted: Vec<(f64, Option<Built>)> = pool.install(|| {
+            (0..n)
+                .into_par_iter()
+                .map(|j| {
+                    if interrupt.load(Ordering::Relaxed) {
+                        return (0.0, None);
+                    }
+                    let built = self.build_run(range.start + j as u64);
+                    let cost = match &built {
+                        Ok((sc, _)) => {
+                            let y = sc.spacecraft.initial_state(&sc.omega0, &sc.attitude0);
+                            let stiffness =
+                                crate::linearize::stiffness(&sc.spacecraft, 0.0, &y, sc.duration);
+                            stiffness.spectral_radius * sc.duration
+                        }
+                        Err(_) => 0.0,
+                    };
+                    (if cost.is_finite() { cost } else { 0.0 }, Some(built))
+                })
+                .collect()
+        });
+        let mut order: Vec<usize> = (0..n).collect();
+        // Stable: equal expectations keep their index order.
+        order.sort_by(|&a, &b| predicted[b].0.total_cmp(&predicted[a].0));
+        let built = predicted.into_iter().map(|(_, b)| Mutex::new(b)).collect();
+        (order, built)
     }
 
     /// What the campaign's summary is computed from, besides the runs.

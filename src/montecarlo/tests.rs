@@ -287,3 +287,70 @@ fn erfc_matches_tabulated_values() {
     }
     assert!((normal_mass(-1.959_963_985, 1.959_963_985) - 0.95).abs() < 1e-6);
 }
+
+/// The list schedule's order: the runs expected to be longest first, which is what their
+/// integrations then cost (RHS evaluations, counted by running them).
+#[test]
+fn the_runs_expected_longest_start_first_and_do_cost_the_most() {
+    // A damper whose dashpot spans two decades: the stiffer runs take smaller explicit steps.
+    let yaml = "name: order\n\
+                body:\n  mass: 100.0\n  principal: [10.0, 9.0, 12.0]\n  spin_axis: [0, 0, 1]\n\
+                effectors:\n  - spring_mass_damper: {name: damper, mass: 1.0, \
+                position: [0.5, 0.0, 0.0], direction: [0, 0, 1], stiffness: 4.0, damping: 1.0}\n\
+                initial:\n  omega: [0.1, 0.0, 1.0]\n\
+                duration: 20.0\n\
+                integrator: {method: dopri5, rtol: 1.0e-8, atol: 1.0e-10}\n\
+                montecarlo:\n  runs: 12\n  seed: 5\n  dispersions:\n\
+                \x20   - {path: \"effectors[damper].damping\", uniform: {min: 1.0, max: 400.0}}\n";
+    let sc = scenario::parse(
+        Path::new("order.yaml"),
+        yaml.to_string(),
+        &Overrides::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let p = Prepared::new(sc, "order.yaml", None, None).unwrap_or_else(|e| panic!("{e}"));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let never = AtomicBool::new(false);
+    let (order, _) = p.longest_first(0..12, &pool, &never);
+    let mut sorted = order.clone();
+    sorted.sort_unstable();
+    assert_eq!(
+        sorted,
+        (0..12).collect::<Vec<_>>(),
+        "not a permutation: {order:?}"
+    );
+    let rhs = p
+        .columns
+        .iter()
+        .position(|c| c == "rhs_evaluations")
+        .expect("an rhs_evaluations column");
+    let cost: Vec<f64> = order
+        .iter()
+        .map(|&j| {
+            let row = p.run_one(j as u64, &never).expect("a row");
+            row.values[rhs].expect("a count")
+        })
+        .collect();
+    let (first, last) = (cost[..4].iter().sum::<f64>(), cost[8..].iter().sum::<f64>());
+    assert!(
+        first > 2.0 * last,
+        "the first four runs in the order cost {first} evaluations, the last four {last}: {cost:?}"
+    );
+    // One thread, or many runs per thread: index order, and no prediction.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    assert_eq!(
+        p.longest_first(0..12, &one, &never).0,
+        (0..12).collect::<Vec<_>>()
+    );
+    let many = ORDERED_RUNS_PER_THREAD * 2 + 1;
+    assert_eq!(
+        p.longest_first(0..many as u64, &pool, &never).0,
+        (0..many).collect::<Vec<_>>()
+    );
+}
