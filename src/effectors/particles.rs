@@ -133,6 +133,24 @@ pub trait ParticleModel: Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// [`Effector::rhs_alone`] in closed form: the hub's angular acceleration `omega_dot`
+    /// (rad/s², body axes) and the coordinates' accelerations `u_dot`, given the hub's inertia
+    /// `hub_inertia` (kg m², about its centre of mass, lower triangle read) and mass
+    /// `hub_mass` (kg). Returns false, having written nothing, for a model without one (or
+    /// when its solve fails); the spacecraft then couples and solves.
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_alone_closed_form(
+        &self,
+        _q: &[f64],
+        _u: &[f64],
+        _omega: &Vector3<f64>,
+        _hub_inertia: &Matrix3<f64>,
+        _hub_mass: f64,
+        _omega_dot: &mut Vector3<f64>,
+        _u_dot: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// The particles' [`Momentum`] (relative to the hub's centre of mass, with the hub at rest
     /// and turning at `omega`) in closed form, for a model that has one; `None`, and the
     /// particles are summed instead, otherwise.
@@ -653,6 +671,36 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
             && self
                 .model
                 .couple_alone_closed_form(q, u, &hub.omega, hub_mass, coupling, scratch)
+    }
+
+    fn rhs_alone(
+        &self,
+        hub: &HubState,
+        hub_inertia: &Matrix3<f64>,
+        hub_mass: f64,
+        x: &[f64],
+        omega_dot: &mut Vector3<f64>,
+        dx: &mut [f64],
+    ) -> bool {
+        let n = self.model.num_coordinates();
+        let (q, u) = (&x[..n], &x[n..2 * n]);
+        let mut u_dot = [0.0; MAX_COORDINATES];
+        if !self.model.rhs_alone_closed_form(
+            q,
+            u,
+            &hub.omega,
+            hub_inertia,
+            hub_mass,
+            omega_dot,
+            &mut u_dot[..n],
+        ) {
+            return false;
+        }
+        let (rates, rest) = dx.split_at_mut(n);
+        rates.copy_from_slice(u);
+        rest[..n].copy_from_slice(&u_dot[..n]);
+        rest[n] = self.model.dissipation_power(q, u);
+        true
     }
 
     fn derivatives(

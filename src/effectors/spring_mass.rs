@@ -6,7 +6,7 @@
 //! couple correctly through the hub.
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
-use crate::model::{Drawing, HubCoupling, Momentum, Validity};
+use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
 use nalgebra::{Matrix3, Vector3};
 
 /// A spring–mass–dashpot damper.
@@ -29,6 +29,80 @@ pub struct SpringMass {
 
 /// Fraction of the travel past which the damper warns that it nears its stop.
 pub const TRAVEL_WARN: f64 = 0.9;
+
+/// The terms of the two-body reduction ([`ParticleModel::couple_alone_closed_form`]) at one
+/// state.
+struct Reduction {
+    /// Reduced mass m* = m M/(M + m) (kg).
+    reduced_mass: f64,
+    /// Particle position r (m, body axes).
+    r: Vector3<f64>,
+    /// t = r × p̂ (m).
+    t: Vector3<f64>,
+    /// ρ̈ at ω̇ = 0: Q/m* − p̂·c (m/s²).
+    free_acceleration: f64,
+    /// r × (m* (c − p̂ (p̂·c)) + p̂ Q) (N m).
+    moment: Vector3<f64>,
+}
+
+impl Reduction {
+    /// The entries (row, column, value) of m* (|r|² 1 − r rᵀ − t tᵀ) on and below the
+    /// diagonal (kg m²).
+    #[inline(always)]
+    fn added_inertia(&self) -> [(usize, usize, f64); 6] {
+        let (r, t, r2) = (self.r, self.t, self.r.norm_squared());
+        let entry = |i: usize, j: usize| {
+            let diagonal = if i == j { r2 } else { 0.0 };
+            (
+                i,
+                j,
+                self.reduced_mass * (diagonal - r[i] * r[j] - t[i] * t[j]),
+            )
+        };
+        [
+            entry(0, 0),
+            entry(1, 0),
+            entry(2, 0),
+            entry(1, 1),
+            entry(2, 1),
+            entry(2, 2),
+        ]
+    }
+}
+
+impl SpringMass {
+    /// The two-body reduction's terms at coordinate `q`, rate `u` and hub rate `omega`, with
+    /// hub mass `hub_mass` (kg); `None` for a direction that is not a unit vector (the
+    /// reduction is written for one, as scenarios give it).
+    #[inline(always)]
+    fn reduction(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        hub_mass: f64,
+    ) -> Option<Reduction> {
+        let (p, rho_dot) = (self.direction, u[0]);
+        if (p.norm_squared() - 1.0).abs() > 1e-12 {
+            return None;
+        }
+        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
+        let r = self.position + q[0] * p;
+        let c = omega.cross(&omega.cross(&r)) + 2.0 * rho_dot * omega.cross(&p);
+        let mut generalised = [0.0];
+        self.forces(q, u, &mut generalised);
+        let generalised = generalised[0];
+        let pc = p.dot(&c);
+        let pull = m_star * (c - pc * p) + generalised * p;
+        Some(Reduction {
+            reduced_mass: m_star,
+            r,
+            t: r.cross(&p),
+            free_acceleration: generalised / m_star - pc,
+            moment: r.cross(&pull),
+        })
+    }
+}
 
 impl ParticleModel for SpringMass {
     type Cache = ();
@@ -100,33 +174,54 @@ impl ParticleModel for SpringMass {
         coupling: &mut HubCoupling,
         kept: &mut [f64],
     ) -> bool {
-        let (p, rho_dot) = (self.direction, u[0]);
-        if (p.norm_squared() - 1.0).abs() > 1e-12 {
-            // Written for a unit direction (as scenarios give it); the general path otherwise.
+        let Some(terms) = self.reduction(q, u, omega, hub_mass) else {
             return false;
-        }
-        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
-        let r = self.position + q[0] * p;
-        let c = omega.cross(&omega.cross(&r)) + 2.0 * rho_dot * omega.cross(&p);
-        let mut generalised = [0.0];
-        self.forces(q, u, &mut generalised);
-        let generalised = generalised[0];
-        let pc = p.dot(&c);
-        let t = r.cross(&p);
-        let pull = m_star * (c - pc * p) + generalised * p;
-        let moment = r.cross(&pull);
-        let r2 = r.norm_squared();
-        // The rotational block's lower triangle, m* (|r|² 1 − r rᵀ − t tᵀ), entry by entry.
-        let hub = &mut coupling.mass;
-        for (i, j) in [(0, 0), (1, 0), (2, 0), (1, 1), (2, 1), (2, 2)] {
-            let diagonal = if i == j { r2 } else { 0.0 };
-            hub[(3 + i, 3 + j)] += m_star * (diagonal - r[i] * r[j] - t[i] * t[j]);
+        };
+        for (i, j, added) in terms.added_inertia() {
+            coupling.mass[(3 + i, 3 + j)] += added;
         }
         for i in 0..3 {
-            coupling.force[3 + i] -= moment[i];
+            coupling.force[3 + i] -= terms.moment[i];
         }
         // W = [ρ̈ at ω̇ = 0 | 0 0 0 | t], and L = 1.
-        kept[..8].copy_from_slice(&[generalised / m_star - pc, 0.0, 0.0, 0.0, t.x, t.y, t.z, 1.0]);
+        let t = terms.t;
+        kept[..8].copy_from_slice(&[terms.free_acceleration, 0.0, 0.0, 0.0, t.x, t.y, t.z, 1.0]);
+        true
+    }
+    /// The same reduction, solved: one symmetric 3 × 3 system by cofactors.
+    #[inline(always)]
+    fn rhs_alone_closed_form(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        hub_inertia: &Matrix3<f64>,
+        hub_mass: f64,
+        omega_dot: &mut Vector3<f64>,
+        u_dot: &mut [f64],
+    ) -> bool {
+        let Some(terms) = self.reduction(q, u, omega, hub_mass) else {
+            return false;
+        };
+        let mut m = *hub_inertia;
+        for (i, j, added) in terms.added_inertia() {
+            m[(i, j)] += added;
+        }
+        let force = -omega.cross(&(hub_inertia * omega)) - terms.moment;
+        let Some(inverse) = spd_inverse3(
+            m[(0, 0)],
+            m[(1, 0)],
+            m[(2, 0)],
+            m[(1, 1)],
+            m[(2, 1)],
+            m[(2, 2)],
+        ) else {
+            return false;
+        };
+        let w = inverse * force;
+        let t = terms.t;
+        *omega_dot = w;
+        u_dot[0] = terms.free_acceleration - t.x * w.x - t.y * w.y - t.z * w.z;
         true
     }
     fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {

@@ -347,6 +347,24 @@ pub trait Effector: Any + Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// The whole right-hand side of a scene in which this is the only effector and eliminates
+    /// the hub's translation itself (the case of [`Effector::couple_alone`]), in closed form:
+    /// writes the hub's angular acceleration `omega_dot` (rad/s², body axes) and the
+    /// derivatives of its own states `dx`, given the hub's inertia `hub_inertia` (kg m², about
+    /// its centre of mass, lower triangle read) and mass `hub_mass` (kg). Returns false,
+    /// having written nothing, for an effector without this form (the spacecraft then
+    /// couples and solves). Never called with tidal forces.
+    fn rhs_alone(
+        &self,
+        _hub: &HubState,
+        _hub_inertia: &Matrix3<f64>,
+        _hub_mass: f64,
+        _x: &[f64],
+        _omega_dot: &mut Vector3<f64>,
+        _dx: &mut [f64],
+    ) -> bool {
+        false
+    }
     /// Writes the derivatives of its own states given the hub accelerations.
     fn derivatives(
         &self,
@@ -472,15 +490,11 @@ pub struct Spacecraft {
     /// The one effector that moves mass, when there is exactly one: it may eliminate the
     /// hub's translation itself ([`Effector::couple_alone`]).
     alone: Option<usize>,
-    /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient
-    /// and a scratch of at most [`LONE_SCRATCH`] numbers: the right-hand side then takes
-    /// [`Spacecraft::lone_rhs`].
+    /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient:
+    /// the right-hand side then first asks [`Spacecraft::lone_rhs`].
     lone_only: bool,
     dim: usize,
 }
-
-/// The largest scratch [`Spacecraft::lone_rhs`] keeps on the stack (numbers).
-const LONE_SCRATCH: usize = 8;
 
 impl Spacecraft {
     /// A rigid spacecraft with no effectors. `spin_axis` is normalised here.
@@ -581,7 +595,6 @@ impl Spacecraft {
             && self.effectors.len() == 1
             && self.groups.is_empty()
             && self.tidal_source.is_none()
-            && self.scratch_len <= LONE_SCRATCH
     }
 
     /// Whether a lone mass-moving effector may eliminate the hub's translation itself
@@ -869,13 +882,11 @@ impl Spacecraft {
     }
 
     /// Right-hand side of a scene whose one effector moves mass and eliminates the hub's
-    /// translation itself ([`Spacecraft::lone_only`]): the same arithmetic as
-    /// [`Spacecraft::effector_rhs`] with [`solve_hub`], without the loops over effectors and
-    /// groups, the thread-local scratch (its scratch is on the stack) and the 6 × 6 matrix's
-    /// translational rows. Writes the whole of `dydt` and returns true, or returns false
-    /// having written nothing when the effector has no such form after all
-    /// ([`Effector::couple_alone`] false). Out of line, so that the other scenes'
-    /// right-hand sides compile as before.
+    /// translation itself ([`Spacecraft::lone_only`]), from the effector's closed form
+    /// ([`Effector::rhs_alone`]): no coupling matrix, no scratch and no loops over effectors.
+    /// Writes the whole of `dydt` and returns true, or returns false having written nothing
+    /// when the effector has no such form (the general path then runs). Out of line, so that
+    /// the other scenes' right-hand sides compile as before.
     #[inline(never)]
     fn lone_rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) -> bool {
         let omega = Vector3::new(y[0], y[1], y[2]);
@@ -884,41 +895,23 @@ impl Spacecraft {
             omega,
             attitude: &y[3..7],
         };
-        let mut coupling = HubCoupling {
-            mass: Matrix6::zeros(),
-            force: Vector6::zeros(),
-            translation: false,
-            tidal: None,
-        };
-        coupling
-            .mass
-            .fixed_view_mut::<3, 3>(3, 3)
-            .copy_from(&self.hub.inertia);
-        let gyro = -omega.cross(&(self.hub.inertia * omega));
-        coupling.force[3] = gyro[0];
-        coupling.force[4] = gyro[1];
-        coupling.force[5] = gyro[2];
         let (off, n) = (self.offsets[0], self.lens[0]);
-        let x = &y[off..off + n];
-        let mut scratch = [0.0; LONE_SCRATCH];
-        let scratch = &mut scratch[..self.scratch_len];
-        let effector = &self.effectors[0];
         let hub_mass = self.hub_mass.unwrap_or(f64::NAN);
-        if !effector.couple_alone(&hub, hub_mass, x, &mut coupling, scratch) {
+        let mut omega_dot = Vector3::zeros();
+        if !self.effectors[0].rhs_alone(
+            &hub,
+            &self.hub.inertia,
+            hub_mass,
+            &y[off..off + n],
+            &mut omega_dot,
+            &mut dydt[off..off + n],
+        ) {
             return false;
         }
-        // The rotational block's upper triangle, for the solve's fallback.
-        for i in 4..6 {
-            for j in 3..i {
-                coupling.mass[(j, i)] = coupling.mass[(i, j)];
-            }
-        }
-        let accel = solve_hub(&coupling);
-        effector.derivatives(&hub, &accel, x, scratch, &mut dydt[off..off + n]);
         let hub_dy = &mut dydt[..HUB_STATES];
-        hub_dy[0] = accel.angular[0];
-        hub_dy[1] = accel.angular[1];
-        hub_dy[2] = accel.angular[2];
+        hub_dy[0] = omega_dot[0];
+        hub_dy[1] = omega_dot[1];
+        hub_dy[2] = omega_dot[2];
         quaternion_rate(&y[3..7], &omega, &mut hub_dy[3..7]);
         true
     }
@@ -1039,7 +1032,7 @@ fn lone_mover(effectors: &[Box<dyn Effector>]) -> Option<usize> {
 /// cofactors; `None` unless it is positive definite (Sylvester's criterion: a, a d − b² and
 /// the determinant positive).
 #[inline(always)]
-fn spd_inverse3(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Option<Matrix3<f64>> {
+pub(crate) fn spd_inverse3(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Option<Matrix3<f64>> {
     let (c00, c01, c02) = (d * f - e * e, c * e - b * f, b * e - c * d);
     let det = a * c00 + b * c01 + c * c02;
     if !(a > 0.0 && a * d - b * b > 0.0 && det > 0.0) {
