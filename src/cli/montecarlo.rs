@@ -104,6 +104,7 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
             return EXIT_BAD_INPUT;
         }
     };
+    writer.use_threads(threads);
     let interrupt = campaign_interrupt();
     let total = range.end - range.start;
     if !quiet {

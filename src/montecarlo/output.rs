@@ -194,6 +194,8 @@ pub struct CampaignWriter<'a> {
     tally: Tally,
     /// Temporary and final names of the tables, removed on drop until renamed.
     temporary: Vec<(PathBuf, PathBuf)>,
+    /// Threads `finish` may use ([`CampaignWriter::use_threads`]).
+    threads: usize,
 }
 
 /// The writers of a [`CampaignWriter`] while runs are pushed.
@@ -261,6 +263,7 @@ impl<'a> CampaignWriter<'a> {
             }),
             tally: Tally::new(prep.summary_spec()),
             temporary,
+            threads: 1,
         })
     }
 
@@ -280,6 +283,12 @@ impl<'a> CampaignWriter<'a> {
                 self.dir.join("runs.parquet").display()
             )
         })
+    }
+
+    /// Lets [`CampaignWriter::finish`] use `threads` threads (1 unless set): with two or
+    /// more, the MCAP's runs are integrated on a second thread while the first writes them.
+    pub fn use_threads(&mut self, threads: usize) {
+        self.threads = threads.max(1);
     }
 
     /// Runs pushed so far.
@@ -344,7 +353,7 @@ impl<'a> CampaignWriter<'a> {
             if let Some(r) = &doc.ranking
                 && !partial
             {
-                match trajectories(&dir, prep, r, &json, interrupt)? {
+                match trajectories(&dir, prep, r, &json, interrupt, self.threads)? {
                     Some(p) => written.push(p),
                     None => mcap_interrupted = true,
                 }
@@ -858,13 +867,16 @@ impl EventChartData {
 }
 
 /// `campaign.mcap`: the worst, median and best runs re-run with full logging under
-/// `/worst`, `/median`, `/best`, with the summary attached.
+/// `/worst`, `/median`, `/best`, with the summary attached. With `threads` ≥ 2 the runs are
+/// integrated on a thread of their own while this one writes them (through a
+/// [`sim::Relay`]); the file is the same, byte for byte.
 fn trajectories(
     dir: &Path,
     prep: &Prepared,
     ranking: &Ranking,
     summary_json: &str,
     interrupt: &AtomicBool,
+    threads: usize,
 ) -> Result<Option<PathBuf>, String> {
     let picks = [
         ("worst", ranking.worst),
@@ -876,45 +888,37 @@ fn trajectories(
         scenarios.push(prep.build_run(i).map_err(|e| format!("run {i}: {e}"))?.0);
     }
     let path = dir.join("campaign.mcap");
-    let mut logger: Option<McapLogger> = None;
-    let mut meta = BTreeMap::new();
-    let mut attachments = Vec::new();
-    for ((label, i), sc) in picks.iter().zip(&scenarios) {
-        let prefix = format!("/{label}");
-        let mut l = match logger.take() {
-            None => McapLogger::create_prefixed(&path, sc, sc.omega0.norm(), &prefix),
-            Some(prev) => prev.continue_with(sc, sc.omega0.norm(), &prefix),
-        }
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        let outcome = sim::run(
-            sc,
-            &mut l,
-            Control {
-                interrupt,
-                progress: None,
-            },
-        )
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        if outcome.status == crate::sim::Status::Interrupted {
-            // Dropping the logger removes its temporary file.
-            return Ok(None);
-        }
-        l.end_run(&outcome)
-            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        meta.insert(format!("{label}_run"), i.to_string());
-        meta.insert(
-            format!("{label}_status"),
-            outcome.status.label().to_string(),
-        );
-        attachments.push(Attachment {
-            name: format!("{label}.scenario.json"),
-            media_type: "application/json".into(),
-            data: sc.source.as_bytes().to_vec(),
-        });
-        logger = Some(l);
-    }
-    let Some(l) = logger else {
-        return Err("no run to log".into());
+    let control = || Control {
+        interrupt,
+        progress: None,
+    };
+    let logged = if threads >= 2 {
+        std::thread::scope(|scope| {
+            let (to_writer, from_runs) = std::sync::mpsc::sync_channel(RELAYED_BATCHES);
+            let runs = &scenarios;
+            scope.spawn(move || {
+                for sc in runs {
+                    let mut relay = sim::Relay::new(to_writer.clone());
+                    let outcome = sim::run(sc, &mut relay, control());
+                    let go_on = matches!(&outcome, Ok(o) if o.status != sim::Status::Interrupted);
+                    if !relay.finish(outcome) || !go_on {
+                        break;
+                    }
+                }
+            });
+            // `from_runs` is dropped on leaving, before the scope waits for the runs: a run
+            // still sending then stops.
+            log_picks(&path, &picks, &scenarios, &mut |_, logger| {
+                sim::receive_run(&from_runs, logger)
+            })
+        })
+    } else {
+        log_picks(&path, &picks, &scenarios, &mut |k, logger| {
+            sim::run(&scenarios[k], logger, control())
+        })
+    };
+    let Some((l, mut meta, mut attachments)) = logged? else {
+        return Ok(None);
     };
     meta.insert("version".into(), env!("CARGO_PKG_VERSION").into());
     meta.insert("scenario".into(), prep.scenario.name.clone());
@@ -934,6 +938,56 @@ fn trajectories(
     l.finish_with("polhode_campaign", meta, attachments)
         .map(Some)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+
+/// Batches of records a [`sim::Relay`] may send ahead of the MCAP writer.
+const RELAYED_BATCHES: usize = 16;
+
+/// What [`log_picks`] leaves for the file's end: the logger, its metadata and attachments.
+type Picked<'a> = (McapLogger<'a>, BTreeMap<String, String>, Vec<Attachment>);
+
+/// Writes the `picks` (label, run index) into `path`, one after the other, the sink calls of
+/// pick `k` (whose scenario is `scenarios[k]`) coming from `run(k, logger)`. `None` when a
+/// run was interrupted (the temporary file is removed).
+fn log_picks<'a>(
+    path: &Path,
+    picks: &[(&str, u64)],
+    scenarios: &'a [scenario::Scenario],
+    run: &mut dyn FnMut(usize, &mut dyn sim::Sink) -> std::io::Result<sim::Outcome>,
+) -> Result<Option<Picked<'a>>, String> {
+    let fail = |e: std::io::Error| format!("cannot write {}: {e}", path.display());
+    let mut logger: Option<McapLogger> = None;
+    let mut meta = BTreeMap::new();
+    let mut attachments = Vec::new();
+    for (k, ((label, i), sc)) in picks.iter().zip(scenarios).enumerate() {
+        let prefix = format!("/{label}");
+        let mut l = match logger.take() {
+            None => McapLogger::create_prefixed(path, sc, sc.omega0.norm(), &prefix),
+            Some(prev) => prev.continue_with(sc, sc.omega0.norm(), &prefix),
+        }
+        .map_err(fail)?;
+        let outcome = run(k, &mut l).map_err(fail)?;
+        if outcome.status == crate::sim::Status::Interrupted {
+            // Dropping the logger removes its temporary file.
+            return Ok(None);
+        }
+        l.end_run(&outcome).map_err(fail)?;
+        meta.insert(format!("{label}_run"), i.to_string());
+        meta.insert(
+            format!("{label}_status"),
+            outcome.status.label().to_string(),
+        );
+        attachments.push(Attachment {
+            name: format!("{label}.scenario.json"),
+            media_type: "application/json".into(),
+            data: sc.source.as_bytes().to_vec(),
+        });
+        logger = Some(l);
+    }
+    match logger {
+        Some(l) => Ok(Some((l, meta, attachments))),
+        None => Err("no run to log".into()),
+    }
 }
 
 /// One shard output read back for `merge`.

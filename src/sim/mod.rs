@@ -10,6 +10,7 @@ mod condition;
 mod events;
 mod memory;
 mod method;
+mod relay;
 mod simulation;
 mod steppers;
 
@@ -17,6 +18,7 @@ pub use checks::{DriftLimits, OnBreach};
 pub use condition::{Condition, Quantity};
 pub use memory::Memory;
 pub use method::{Adaptive, Method};
+pub use relay::{Record, Relay, Relayed, receive_run};
 pub use simulation::Simulation;
 pub use steppers::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
 
