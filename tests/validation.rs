@@ -83,6 +83,35 @@ fn flip_interval_matches_elliptic_half_period() {
     }
 }
 
+/// Events on the angle between ω and a principal axis: ω is perpendicular to e2 exactly when
+/// ω2 = 0, so in the intermediate-axis flip the angle to axis 2 rises through 90° at the
+/// times ω2 falls through zero.
+#[test]
+fn the_angle_to_a_principal_axis_crosses_90_degrees_when_omega_2_does_zero() {
+    let events = "events: [{omega_y: {below: 0.0}}, {angle_to_principal_2_deg: {above: 90.0}}]\n";
+    let s = scenario(&rigid_yaml(
+        [1.0, 2.0, 3.0],
+        [1e-2, 1.0, 1e-2],
+        70.0,
+        TIGHT,
+        events,
+    ));
+    let (out, _) = run(&s);
+    let times = |key: &str| -> Vec<f64> {
+        out.events
+            .iter()
+            .filter(|e| e.condition.starts_with(key))
+            .map(|e| e.t)
+            .collect()
+    };
+    let (omega, angle) = (times("omega_y"), times("angle_to_principal_2_deg"));
+    assert!(omega.len() >= 2, "ω2 falls through zero at {omega:?}");
+    assert_eq!(omega.len(), angle.len(), "{omega:?} against {angle:?}");
+    for (a, b) in omega.iter().zip(&angle) {
+        assert!((a - b).abs() < 1e-9, "ω2 = 0 at {a} s, 90° at {b} s");
+    }
+}
+
 /// Landau & Lifshitz §37: spin Ω about the intermediate axis grows transverse errors as e^{kt},
 /// k = Ω sqrt((I3−I2)(I2−I1)/(I1 I3)). Measured from a simulated flip (least-squares slope of
 /// ln|ω1| while the motion is still linear), it must match within 1%.

@@ -690,7 +690,19 @@ impl Spacecraft {
 
     /// Derived quantities (momentum, energy, angles) at state `y`.
     pub fn observe(&self, t: f64, y: &[f64]) -> Observation {
-        observe::observe(self, t, y)
+        observe::observe(self, t, y, true)
+    }
+
+    /// [`Spacecraft::observe`] for the run loop's event checks: the angles to the principal
+    /// axes (three arctangents) are computed only if `angles`, and are NaN otherwise.
+    pub(crate) fn observe_for_events(&self, t: f64, y: &[f64], angles: bool) -> Observation {
+        observe::observe(self, t, y, angles)
+    }
+
+    /// The angle between `omega` (rad/s, body axes) and each principal axis of the hub, in
+    /// principal order (rad, [0, π]).
+    pub(crate) fn angles_to_principal(&self, omega: &Vector3<f64>) -> [f64; 3] {
+        observe::angles_to_principal(self, omega)
     }
 
     /// Momentum, energy and `|q|` only (no angles): cheap enough for every step.

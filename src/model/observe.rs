@@ -154,11 +154,22 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
     (inv, attitude)
 }
 
-pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64]) -> Observation {
+/// The angle between `omega` and each principal axis of the hub, in principal order (rad).
+pub(super) fn angles_to_principal(sc: &Spacecraft, omega: &Vector3<f64>) -> [f64; 3] {
+    let axes = &sc.hub.principal_axes;
+    let angle = |c: usize| angle_between(omega, &axes.column(c).into());
+    [angle(0), angle(1), angle(2)]
+}
+
+/// The observation at state `y`; its angles to the principal axes are NaN unless `angles`.
+pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64], angles: bool) -> Observation {
     let (inv, attitude) = invariants(sc, t, y);
     let omega = Vector3::new(y[0], y[1], y[2]);
-    let axes = &sc.hub.principal_axes;
-    let angles_to_principal = [0, 1, 2].map(|c| angle_between(&omega, &axes.column(c).into()));
+    let angles_to_principal = if angles {
+        angles_to_principal(sc, &omega)
+    } else {
+        [f64::NAN; 3]
+    };
     Observation {
         t,
         omega,

@@ -401,6 +401,12 @@ fn drive<M: Stepper>(
         .map(|c| Watch::new(c, true))
         .chain(sim.events.iter().map(|c| Watch::new(c, false)))
         .collect();
+    // The event checks' observations compute the angles to the principal axes only when a
+    // condition watches one (three arctangents a check).
+    let watched_angles = watches
+        .iter()
+        .any(|w| matches!(w.condition.quantity, Quantity::AngleToPrincipalDeg(_)));
+    let observe_for_events = |t: f64, y: &[f64]| sc.observe_for_events(t, y, watched_angles);
     // Effectors whose models have a validity range, and how far each has been reported
     // (0: not yet, 1: warned, 2: warned past the limit).
     let ranged: Vec<usize> = (0..sc.effectors().len())
@@ -519,7 +525,7 @@ fn drive<M: Stepper>(
         let o1 = if watches.is_empty() {
             None
         } else {
-            Some(sc.observe(t1, stepper.y()))
+            Some(observe_for_events(t1, stepper.y()))
         };
         let step_invariants = match &o1 {
             Some(o) => o.invariants(),
@@ -617,7 +623,7 @@ fn drive<M: Stepper>(
             for j in 1..=checks {
                 let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
                 stepper.interpolate(t, &mut buf);
-                grid.push((t, sc.observe(t, &buf)));
+                grid.push((t, observe_for_events(t, &buf)));
             }
             grid.push((t1, o1.clone()));
             // A sign change is located on the dense output.
@@ -637,13 +643,13 @@ fn drive<M: Stepper>(
                     let (ga, gb) = (c.margin(&w[0].1), c.margin(&w[1].1));
                     let crossing = |up: bool| {
                         let mut scratch = vec![0.0; n];
+                        let margin = |t: f64, y: &[f64]| c.margin(&observe_for_events(t, y));
                         if up {
-                            locate(&stepper, sc, &|o| c.margin(o), a, b, ga, gb, &mut scratch)
+                            locate(&stepper, &margin, a, b, ga, gb, &mut scratch)
                         } else {
                             locate(
                                 &stepper,
-                                sc,
-                                &|o| -c.margin(o),
+                                &|t, y| -margin(t, y),
                                 a,
                                 b,
                                 -ga,
@@ -685,7 +691,14 @@ fn drive<M: Stepper>(
                 (true, _) => {
                     let o = if tk == t1 {
                         buf.copy_from_slice(stepper.y());
-                        o1.clone().unwrap_or_else(|| sc.observe(t1, &buf))
+                        match &o1 {
+                            Some(o) if watched_angles => o.clone(),
+                            Some(o) => Observation {
+                                angles_to_principal: sc.angles_to_principal(&o.omega),
+                                ..o.clone()
+                            },
+                            None => sc.observe(t1, &buf),
+                        }
                     } else {
                         stepper.interpolate(tk, &mut buf);
                         sc.observe(tk, &buf)
@@ -785,13 +798,11 @@ fn dense_failure(t0: f64, t1: f64, y: &[f64], sim: &Simulation) -> Status {
     }
 }
 
-/// Locates the root of `margin` in `[a, b]` on the dense output (Illinois regula falsi),
-/// given `margin(a) = ga ≤ 0 < gb = margin(b)`.
-#[allow(clippy::too_many_arguments)]
+/// Locates the root of `margin` (of the time and the state there) in `[a, b]` on the dense
+/// output (Illinois regula falsi), given `margin(a) = ga ≤ 0 < gb = margin(b)`.
 fn locate<M: Stepper>(
     stepper: &M,
-    sc: &Spacecraft,
-    margin: &dyn Fn(&Observation) -> f64,
+    margin: &dyn Fn(f64, &[f64]) -> f64,
     mut a: f64,
     mut b: f64,
     mut ga: f64,
@@ -807,7 +818,7 @@ fn locate<M: Stepper>(
         }
         let t = ((a * gb - b * ga) / (gb - ga)).clamp(a.min(b), a.max(b));
         stepper.interpolate(t, buf);
-        let g = margin(&sc.observe(t, buf));
+        let g = margin(t, buf);
         if g > 0.0 {
             b = t;
             gb = g;
