@@ -133,6 +133,8 @@ pub trait ParticleModel: Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// Whether it implements [`ParticleModel::rhs_alone_closed_form`].
+    const HAS_RHS_ALONE: bool = false;
     /// [`Effector::rhs_alone`] in closed form: the hub's angular acceleration `omega_dot`
     /// (rad/s², body axes) and the coordinates' accelerations `u_dot`, given the hub's inertia
     /// `hub_inertia` (kg m², about its centre of mass, lower triangle read) and mass
@@ -671,6 +673,10 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
             && self
                 .model
                 .couple_alone_closed_form(q, u, &hub.omega, hub_mass, coupling, scratch)
+    }
+
+    fn has_rhs_alone(&self) -> bool {
+        P::HAS_RHS_ALONE
     }
 
     fn rhs_alone(

@@ -106,6 +106,7 @@ impl SpringMass {
 
 impl ParticleModel for SpringMass {
     type Cache = ();
+    const HAS_RHS_ALONE: bool = true;
     fn kind(&self) -> &'static str {
         "spring_mass_damper"
     }

@@ -347,6 +347,11 @@ pub trait Effector: Any + Debug + Send + Sync {
     ) -> bool {
         false
     }
+    /// Whether it has [`Effector::rhs_alone`]'s closed form (which may still decline a
+    /// state): the spacecraft asks for it only then.
+    fn has_rhs_alone(&self) -> bool {
+        false
+    }
     /// The whole right-hand side of a scene in which this is the only effector and eliminates
     /// the hub's translation itself (the case of [`Effector::couple_alone`]), in closed form:
     /// writes the hub's angular acceleration `omega_dot` (rad/s², body axes) and the
@@ -490,8 +495,9 @@ pub struct Spacecraft {
     /// The one effector that moves mass, when there is exactly one: it may eliminate the
     /// hub's translation itself ([`Effector::couple_alone`]).
     alone: Option<usize>,
-    /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient:
-    /// the right-hand side then first asks [`Spacecraft::lone_rhs`].
+    /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient,
+    /// and has a closed form for the whole right-hand side ([`Effector::has_rhs_alone`]): the
+    /// right-hand side then first asks [`Spacecraft::lone_rhs`].
     lone_only: bool,
     dim: usize,
 }
@@ -595,6 +601,7 @@ impl Spacecraft {
             && self.effectors.len() == 1
             && self.groups.is_empty()
             && self.tidal_source.is_none()
+            && self.effectors[0].has_rhs_alone()
     }
 
     /// Whether a lone mass-moving effector may eliminate the hub's translation itself
