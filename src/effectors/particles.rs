@@ -502,9 +502,17 @@ impl<P: ParticleModel> ParticleEffector<P> {
             }
             u_dot[i] = s * l[packed(i, i)];
         }
+        self.write_derivatives(q, u, &u_dot[..n], dx);
+    }
+
+    /// Writes its states' derivatives into `dx`: the coordinates' rates `u`, their
+    /// accelerations `u_dot`, then the dissipated energy's rate, at coordinates `q`.
+    #[inline(always)]
+    fn write_derivatives(&self, q: &[f64], u: &[f64], u_dot: &[f64], dx: &mut [f64]) {
+        let n = u.len();
         let (rates, rest) = dx.split_at_mut(n);
         rates.copy_from_slice(u);
-        rest[..n].copy_from_slice(&u_dot[..n]);
+        rest[..n].copy_from_slice(u_dot);
         rest[n] = self.model.dissipation_power(q, u);
     }
 
@@ -702,10 +710,7 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
         ) {
             return false;
         }
-        let (rates, rest) = dx.split_at_mut(n);
-        rates.copy_from_slice(u);
-        rest[..n].copy_from_slice(&u_dot[..n]);
-        rest[n] = self.model.dissipation_power(q, u);
+        self.write_derivatives(q, u, &u_dot[..n], dx);
         true
     }
 
