@@ -81,10 +81,23 @@ impl Moments {
         Some(Moments { i: [i1, i2, i3] })
     }
 
-    /// Δ1 = H² − 2T I1 and Δ3 = 2T I3 − H² (clamped at 0 against rounding) and
-    /// Δ2 = H² − 2T I2 (kg² m⁴ s⁻²), for |H| = `h` (N m s) and T = `energy` (J).
+    /// The kinetic energy (J) nearest `energy` that a body with |H| = `h` (N m s) can have:
+    /// T between the spin about the major axis, |H|²/(2 I3), and about the minor axis,
+    /// |H|²/(2 I1). A slow state outside that band (an overshoot of the slow stepper towards a
+    /// pure spin) stands for the pure spin at its edge, never for a rate larger than |H|
+    /// allows.
+    pub fn admissible_energy(&self, h: f64, energy: f64) -> f64 {
+        let [i1, _, i3] = self.i;
+        let h2 = h * h;
+        energy.clamp(h2 / (2.0 * i3), h2 / (2.0 * i1))
+    }
+
+    /// Δ1 = H² − 2T I1 and Δ3 = 2T I3 − H² (T taken in the admissible band, and clamped at 0
+    /// against rounding) and Δ2 = H² − 2T I2 (kg² m⁴ s⁻²), for |H| = `h` (N m s) and
+    /// T = `energy` (J).
     pub fn deltas(&self, h: f64, energy: f64) -> (f64, f64, f64) {
         let [i1, i2, i3] = self.i;
+        let energy = self.admissible_energy(h, energy);
         let h2 = h * h;
         let d1 = (h2 - 2.0 * energy * i1).max(0.0);
         let d3 = (2.0 * energy * i3 - h2).max(0.0);

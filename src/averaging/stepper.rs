@@ -11,6 +11,10 @@ use crate::sim::Adaptive;
 use nalgebra::{Matrix3, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
 use std::f64::consts::TAU;
 
+/// Relative distance |H² − 2T I2| / H² from the separatrix within which its side is
+/// rounding (a few ulp of the terms H² and 2T I2).
+const SEPARATRIX_ROUNDING: f64 = 64.0 * f64::EPSILON;
+
 /// Slow state layout: z = [|H|/H₀, T/T₀, polhode phase (periods), precession angle (rad),
 /// W₁/T₀, …].
 const H: usize = 0;
@@ -40,7 +44,9 @@ struct SlowRates {
 impl SlowSystem {
     fn rates(&self, z: &[f64], dissipation: Option<&mut [f64]>) -> SlowRates {
         let h = z[H] * self.h0;
-        let energy = z[T] * self.t0;
+        // Past a pure spin the rates are the pure spin's (zero for a passive scene), so an
+        // overshoot of the slow stepper neither pumps nor drains what cannot be there.
+        let energy = self.moments.admissible_energy(h, z[T] * self.t0);
         let averages = self.moments.period_averages(h, energy);
         let motion = SecularMotion {
             omega_omega: self.axes * averages.omega_omega * self.axes.transpose(),
@@ -259,6 +265,20 @@ impl AveragedStepper {
         z0[PHASE] = phase;
         for (k, &o) in offsets.iter().enumerate() {
             z0[EFFECTORS + k] = y0[o] / t0;
+        }
+        // On the separatrix the averaged rates vanish (the period is infinite and ω sits on
+        // the intermediate axis), so the slow system would stay there for ever while the full
+        // motion leaves it within a few periods. Δ2 = H² − 2T I2 is known to a few ulp of H²:
+        // inside that, the side of the separatrix is not known either.
+        let (_, d2, _) = moments.deltas(h0, t0);
+        if i1 < i2 && i2 < i3 && d2.abs() <= SEPARATRIX_ROUNDING * h0 * h0 {
+            return Err(format!(
+                "method `averaged`: the initial state is on the separatrix to the precision of \
+                 |H| and T (|H² − 2T I2| / H² = {:.1e}, within {SEPARATRIX_ROUNDING:.0e} of \
+                 rounding), where the averaged rates vanish and the averaged motion cannot \
+                 leave it while the full motion does; use dop853",
+                d2.abs() / (h0 * h0)
+            ));
         }
         let (epsilon, fast) = system.epsilon(&z0);
         if epsilon.is_nan() || epsilon > MAX_EPSILON {

@@ -62,6 +62,9 @@ impl Effector for EnergySink {
     fn torque_only(&self) -> bool {
         true
     }
+    fn needs_rigid_spacecraft(&self) -> bool {
+        true
+    }
     fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
         -self.coefficient * self.transverse_rate(&hub.omega)
     }

@@ -284,12 +284,8 @@ impl LvlhSystem<'_> {
 
 /// Refuses what has no fixed LVLH equilibrium or what this linearisation does not cover.
 fn check_applicable(sc: &Spacecraft, orbit: &Orbit) -> Result<(), String> {
-    if sc.motion().is_some() {
-        return Err(
-            "the hub's rotation is prescribed (`hub_motion`): no free libration to \
-                    linearise"
-                .into(),
-        );
+    if let Some(refusal) = crate::sim::linearize_refusal(sc, crate::sim::Linearisation::Lvlh) {
+        return Err(refusal.to_string());
     }
     let e = orbit.elements().eccentricity;
     if e != 0.0 {

@@ -272,12 +272,10 @@ fn central_jacobian(
 
 /// Linearises `sc` about steady spin at `spin_rate` (rad/s) about its spin axis.
 pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, String> {
-    if sc.motion().is_some() {
-        return Err(
-            "the hub's rotation is prescribed (`hub_motion`), so there is no free \
-                    steady spin to linearise about"
-                .into(),
-        );
+    // The contract (src/sim/support.rs): held states, a prescribed motion and environmental
+    // torques are refused, naming the effector.
+    if let Some(refusal) = crate::sim::linearize_refusal(sc, crate::sim::Linearisation::Spin) {
+        return Err(refusal.to_string());
     }
     let s = sc.spin_axis;
     let rest = sc.rest_state(&Vector3::zeros(), &UnitQuaternion::identity());
@@ -669,6 +667,9 @@ pub fn linearize_driven(
     sc: &Spacecraft,
     omega: &Vector3<f64>,
 ) -> Result<DrivenLinearization, String> {
+    if let Some(refusal) = crate::sim::linearize_refusal(sc, crate::sim::Linearisation::Driven) {
+        return Err(refusal.to_string());
+    }
     let y_eq = sc.rest_state(omega, &UnitQuaternion::identity());
     let (idx, names) = dynamic_states(sc);
     if idx.is_empty() {

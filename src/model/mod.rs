@@ -262,6 +262,13 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn is_external(&self) -> bool {
         false
     }
+    /// Whether its model takes the spacecraft to be otherwise rigid (the quasi-rigid energy
+    /// sink, whose Ĥ is the hub's Iω): then no effector that carries momentum of its own
+    /// (one that is not [`Effector::torque_only`]) may share the spacecraft, whichever is
+    /// added first.
+    fn needs_rigid_spacecraft(&self) -> bool {
+        false
+    }
     /// The first time after `t` (s) at which its right-hand side is not smooth (a commanded
     /// torque's step or kink), for the integrators to stop at; `None` when there is none.
     fn next_breakpoint(&self, _t: f64) -> Option<f64> {
@@ -542,6 +549,31 @@ impl Spacecraft {
             return Err(AddEffectorError(format!(
                 "two effectors are named `{}`; names must be unique",
                 effector.name()
+            )));
+        }
+        let rigid_only = |e: &dyn Effector| e.needs_rigid_spacecraft();
+        let carries_momentum = |e: &dyn Effector| !e.torque_only();
+        let clash = if rigid_only(effector.as_ref()) {
+            self.effectors.iter().find(|e| carries_momentum(e.as_ref()))
+        } else if carries_momentum(effector.as_ref()) {
+            self.effectors.iter().find(|e| rigid_only(e.as_ref()))
+        } else {
+            None
+        };
+        if let Some(other) = clash {
+            let (sink, carrier) = if rigid_only(effector.as_ref()) {
+                (effector.as_ref(), other.as_ref())
+            } else {
+                (other.as_ref(), effector.as_ref())
+            };
+            return Err(AddEffectorError(format!(
+                "effector `{}` ({}) models a quasi-rigid spacecraft, and effector `{}` ({}) \
+                 carries momentum of its own, so |H| would not be kept; model the \
+                 dissipation with the effector that carries the momentum instead",
+                sink.name(),
+                sink.kind(),
+                carrier.name(),
+                carrier.kind()
             )));
         }
         if effector.moves_mass() {

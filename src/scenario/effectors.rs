@@ -1146,14 +1146,15 @@ pub(super) fn build(
         }
     }
     // The energy sink is the quasi-rigid model: its Ĥ is the hub's Iω, so it keeps |H| only
-    // when no other effector carries momentum.
+    // when no other effector carries momentum (every effector that is not torque-only does;
+    // `Spacecraft::add_effector` refuses the same, for spacecraft built in code).
     let sink = specs
         .iter()
         .position(|s| matches!(s.value, EffectorSpec::EnergySink(_)));
     if let Some(i) = sink
         && out
             .iter()
-            .any(|e| e.moves_mass() || e.kind() == "wheel_damper")
+            .any(|e| !e.needs_rigid_spacecraft() && !e.torque_only())
     {
         return Err(ScenarioError::at(
             cx.path,

@@ -1036,29 +1036,10 @@ impl ScenarioFile {
             }
             spacecraft.set_motion(Box::new(motion));
         }
-        let free_rigid = spacecraft.effectors().is_empty() && spacecraft.motion().is_none();
-        if matches!(method, Method::Exact) && !free_rigid {
-            return Err(err(
-                method_l,
-                method_field,
-                "method `exact` solves the torque-free rigid body only, and this spacecraft \
-                 has effectors or a prescribed motion; use dop853, dopri5 or auto"
-                    .into(),
-            ));
-        }
-        if matches!(method, Method::Averaged(_))
-            && let Some(why) = crate::averaging::refusal(&spacecraft)
-        {
-            return Err(err(method_l, method_field, why));
-        }
-        if matches!(method, Method::Splitting { .. }) && spacecraft.motion().is_some() {
-            return Err(err(
-                method_l,
-                method_field,
-                "method `splitting` composes the free rigid-body flow with the rest, and the \
-                 hub's rotation here is prescribed (`hub_motion`); use dop853 or auto"
-                    .into(),
-            ));
+        // The method contract (src/sim/support.rs): refused here with the field located, and
+        // checked again before any run's first step.
+        if !auto && let Some(refusal) = method.refusal(&spacecraft, duration) {
+            return Err(err(method_l, method_field, refusal.to_string()));
         }
         let (method, method_choice) = if auto {
             let (m, why) = choose_method(&spacecraft, &omega0, &attitude0, duration, adaptive);

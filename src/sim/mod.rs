@@ -13,6 +13,7 @@ mod method;
 mod relay;
 mod simulation;
 mod steppers;
+mod support;
 
 pub use checks::{DriftLimits, OnBreach};
 pub use condition::{Condition, Quantity};
@@ -21,6 +22,10 @@ pub use method::{Adaptive, Method};
 pub use relay::{Record, Relay, Relayed, receive_run};
 pub use simulation::Simulation;
 pub use steppers::{AnyStepper, ExactStepper, LieStepper, SplittingStepper};
+pub use support::{
+    Feature, Features, Linearisation, Refusal, Support, linearize_refusal, linearize_support,
+    support,
+};
 
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};

@@ -54,6 +54,10 @@ impl AnyStepper {
         dense_output: bool,
     ) -> Result<Self, String> {
         let sc = &sim.spacecraft;
+        // The method contract (`support.rs`): every run, whatever built it, is checked here.
+        if let Some(refusal) = sim.method.refusal(sc, sim.duration) {
+            return Err(refusal.to_string());
+        }
         let tol = |a: Adaptive| {
             (
                 Tolerances {
@@ -285,8 +289,10 @@ impl LieStepper {
 }
 
 impl Stepper for LieStepper {
-    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
-        // Rigid bodies only (no effector, so no breakpoint and no held state).
+    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, y: &[f64]) {
+        // At a breakpoint the run updated the held states: continue from them. Each step
+        // evaluates its own stages, so nothing else is carried over.
+        self.y.copy_from_slice(y);
     }
     fn t(&self) -> f64 {
         self.t
@@ -543,8 +549,14 @@ struct RkScratch {
 }
 
 impl Stepper for SplittingStepper {
-    fn restart<S: OdeSystem + ?Sized>(&mut self, _sys: &S, _y: &[f64]) {
-        // Rigid bodies only (no effector, so no breakpoint and no held state).
+    fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]) {
+        // At a breakpoint the run updated the held states: continue from them, with f at the
+        // new state for the next step's dense output (the right-hand side jumps there).
+        self.y.copy_from_slice(y);
+        if !self.f_end.is_empty() {
+            sys.rhs(self.t, &self.y, &mut self.f_end);
+            self.stats.rhs_evaluations += 1;
+        }
     }
     fn t(&self) -> f64 {
         self.t
