@@ -95,6 +95,7 @@ fn decode_doubles(data: &[u8], out: &mut [f64]) -> Result<(), String> {
 
 /// Reads the telemetry and effector channels of the log at `path`.
 pub fn read(path: &Path) -> Result<RunLog, String> {
+    crate::outputs::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let not_a_log = |e: mcap::McapError| {
         format!(

@@ -967,6 +967,9 @@ fn file_sha256(path: &Path) -> std::io::Result<String> {
 
 fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
     let d = dir.display();
+    for name in ["campaign.json", "runs.csv", "scenario.yaml"] {
+        crate::outputs::note_input(&dir.join(name));
+    }
     let manifest_text = std::fs::read_to_string(dir.join("campaign.json"))
         .map_err(|e| format!("{d}: no finished campaign output here (campaign.json: {e})"))?;
     let manifest: Manifest = serde_json::from_str(&manifest_text)

@@ -2,6 +2,7 @@
 //! unique to the writer (process id and a process-wide counter, so threads and processes
 //! writing the same target never share one), synced, then renamed over the target.
 
+use super::inputs::check_not_input;
 use std::fs::File;
 use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
@@ -60,8 +61,9 @@ impl TempFile {
         &self.path
     }
 
-    /// Renames it to `to`.
+    /// Renames it to `to` (never onto an input of this process: [`check_not_input`]).
     pub fn persist(mut self, to: &Path) -> io::Result<()> {
+        check_not_input(to)?;
         std::fs::rename(&self.path, to)?;
         self.keep = true;
         Ok(())
@@ -79,6 +81,7 @@ impl Drop for TempFile {
 /// Writes `bytes` to `path` through a temporary file and a rename.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {
     check_replaceable(path)?;
+    check_not_input(path)?;
     let result = (|| {
         let (temp, mut f) = TempFile::beside(path, "out")?;
         f.write_all(bytes)?;

@@ -11,14 +11,18 @@
 //!   to the writer (process id and counter), in its destination directory, then renamed.
 //! - [`sanitize`] and [`check_component`]: a file name built from user text stays one plain
 //!   path component.
+//! - [`note_input`] and [`check_not_input`]: every file read as an input is remembered, and
+//!   every write and removal above refuses it, whichever writer forgot its plan.
 
 mod atomic;
 mod identity;
+mod inputs;
 mod names;
 mod owned_dir;
 
 pub use atomic::{TempFile, check_replaceable, is_temporary_of, temporary_path, write_atomically};
 pub use identity::Identity;
+pub use inputs::{check_not_input, note_input};
 pub use names::{MAX_NAME_BYTES, check_component, sanitize};
 pub use owned_dir::{MARKER, OwnedDir};
 
@@ -130,6 +134,21 @@ impl Plan {
                 };
                 if !conflict {
                     continue;
+                }
+                if (out.kind, other.kind) == (Kind::Output, Kind::Output) {
+                    let other_path = if other.path == out.path {
+                        String::new()
+                    } else {
+                        format!(" and {}", other.path.display())
+                    };
+                    return Err(format!(
+                        "{} and {} both name {}{other_path}{}: give each output its own file; \
+                         nothing was written",
+                        out.role,
+                        other.role,
+                        out.path.display(),
+                        resolved(out)
+                    ));
                 }
                 let what = match (out.kind, other.kind) {
                     (Kind::Output, _) => "is the same file as",

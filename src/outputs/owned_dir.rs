@@ -4,6 +4,7 @@
 //! it, and removes only what a previous marker listed.
 
 use super::atomic::is_temporary_of;
+use super::inputs::check_not_input;
 use super::names::check_component;
 use std::fs::File;
 use std::io::{Read as _, Seek as _, SeekFrom, Write as _};
@@ -151,6 +152,7 @@ impl OwnedDir {
         // Remove the previous files, then their temporaries.
         let remove = |n: &str| {
             let p = dir.join(n);
+            check_not_input(&p).map_err(|e| e.to_string())?;
             match std::fs::remove_file(&p) {
                 Ok(()) => Ok(()),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
