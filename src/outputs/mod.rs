@@ -153,7 +153,7 @@ impl Plan {
                 let what = match (out.kind, other.kind) {
                     (Kind::Output, _) => "is the same file as",
                     (_, Kind::Input | Kind::OutputDir) if other.identity.same(&out.identity) => {
-                        "is the same directory as"
+                        "is the same path as"
                     }
                     _ => "is the directory that holds",
                 };
