@@ -126,6 +126,7 @@ pub mod log;
 pub mod model;
 pub mod montecarlo;
 pub mod orbit;
+pub mod outputs;
 pub mod plot;
 pub mod scenario;
 pub mod sim;

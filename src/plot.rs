@@ -1325,8 +1325,15 @@ fn count_hits(style: Style, pieces: &[Vec<(f64, f64)>], rect: &Rect) -> usize {
 }
 
 /// Renders an SVG document (as written by [`Chart::to_svg`]) to a PNG file at 1.5 times its
-/// size, on white, with the system's fonts (DejaVu Sans for `sans-serif` when present).
+/// size, on white, with the system's fonts (DejaVu Sans for `sans-serif` when present),
+/// written whole or not at all ([`crate::outputs::write_atomically`]).
 pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
+    let bytes = png_bytes(svg)?;
+    crate::outputs::write_atomically(path, &bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The PNG bytes of [`write_png`].
+fn png_bytes(svg: &str) -> Result<Vec<u8>, String> {
     use resvg::{tiny_skia, usvg};
     let mut options = usvg::Options::default();
     {
@@ -1354,9 +1361,7 @@ pub fn write_png(svg: &str, path: &std::path::Path) -> Result<(), String> {
         tiny_skia::Transform::from_scale(scale, scale),
         &mut pixmap.as_mut(),
     );
-    pixmap
-        .save_png(path)
-        .map_err(|e| format!("{}: {e}", path.display()))
+    pixmap.encode_png().map_err(|e| format!("PNG: {e}"))
 }
 
 /// Writes `chart` as `<stem>.svg` (900 × 600) and `<stem>.png` (1350 × 900 px), each under a temporary name
@@ -1379,39 +1384,18 @@ pub fn svg_and_png_as(
         return Ok(Vec::new());
     };
     let svg = chart.to_svg(900, 600);
+    let png =
+        png_bytes(&svg).map_err(|e| format!("{}: {e}", first.with_extension("png").display()))?;
     let mut written = Vec::new();
-    let png_path = first.with_extension("png");
-    let mut png: Option<Vec<u8>> = None;
     for stem in std::iter::once(first).chain(rest) {
-        let svg_path = stem.with_extension("svg");
-        crate::log::write_atomically(&svg_path, svg.as_bytes())
-            .map_err(|e| format!("{}: {e}", svg_path.display()))?;
-        written.push(svg_path);
-        let path = stem.with_extension("png");
-        match &png {
-            None => {
-                let name = path
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default();
-                let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-                let result = write_png(&svg, &tmp)
-                    .and_then(|()| std::fs::rename(&tmp, &path).map_err(|e| e.to_string()));
-                if let Err(e) = result {
-                    let _ = std::fs::remove_file(&tmp);
-                    return Err(format!("{}: {e}", path.display()));
-                }
-                if !rest.is_empty() {
-                    png = Some(
-                        std::fs::read(&png_path)
-                            .map_err(|e| format!("{}: {e}", png_path.display()))?,
-                    );
-                }
-            }
-            Some(bytes) => crate::log::write_atomically(&path, bytes)
-                .map_err(|e| format!("{}: {e}", path.display()))?,
+        for (path, bytes) in [
+            (stem.with_extension("svg"), svg.as_bytes()),
+            (stem.with_extension("png"), png.as_slice()),
+        ] {
+            crate::outputs::write_atomically(&path, bytes)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            written.push(path);
         }
-        written.push(path);
     }
     Ok(written)
 }

@@ -96,6 +96,7 @@ fn threads_order_and_shards_give_the_same_result_bit_for_bit() {
     campaign(&[SCENARIO, "--runs", "60", "--threads", "2"], &two);
     assert_same(&one, &two);
     let expected = [
+        ".polhode-outputs",
         "campaign.json",
         "campaign.mcap",
         "flat_spin_time_cdf.png",

@@ -193,7 +193,9 @@ impl PyScenario {
         let products = match detached.value {
             Ok(Ok(p)) => p,
             Ok(Err(RunError::Scenario(e))) => return Err(scenario_error(py, &e)),
-            Ok(Err(RunError::LogTooLarge(m))) => return Err(PyValueError::new_err(m)),
+            Ok(Err(RunError::LogTooLarge(m) | RunError::Refused(m))) => {
+                return Err(PyValueError::new_err(m));
+            }
             Ok(Err(RunError::Io(m))) => return Err(PyOSError::new_err(m)),
             Err(panic) => {
                 return Err(internal_error("running the scenario", panic.as_ref()));

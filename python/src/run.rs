@@ -120,6 +120,8 @@ pub(crate) enum RunError {
     Scenario(scenario::ScenarioError),
     /// The log would be too large (the CLI's message).
     LogTooLarge(String),
+    /// The log would be written over the scenario's file ([`polhode::outputs::Plan`]).
+    Refused(String),
     /// The log could not be created, written or finished.
     Io(String),
 }
@@ -133,6 +135,16 @@ pub(crate) fn execute(
     interrupt: &AtomicBool,
 ) -> Result<Products, RunError> {
     let s = scenario::parse(path, source, overrides).map_err(RunError::Scenario)?;
+    if log {
+        let mut plan = polhode::outputs::Plan::new();
+        if path != Path::new(crate::TEXT_SOURCE_NAME) && path != Path::new(crate::DICT_SOURCE_NAME)
+        {
+            plan.input("the scenario", path);
+        }
+        plan.output("log=", &s.mcap_path)
+            .check()
+            .map_err(RunError::Refused)?;
+    }
     let logger = if log {
         let mut logger = McapLogger::create(&s.mcap_path, &s, s.omega0.norm()).map_err(|e| {
             RunError::Io(format!(

@@ -153,7 +153,8 @@ pub fn drift(
         files.extend(svg_and_png(&c, &out.join(file))?);
     }
     let p = out.join("drift.csv");
-    std::fs::write(&p, table).map_err(|e| format!("{}: {e}", p.display()))?;
+    crate::outputs::write_atomically(&p, table.as_bytes())
+        .map_err(|e| format!("{}: {e}", p.display()))?;
     files.push(p);
     Ok(files)
 }
@@ -320,7 +321,8 @@ pub fn stability(out: &Path, mut progress: impl FnMut(&str)) -> Result<Vec<PathB
     ));
     let mut files = svg_and_png(&c, &out.join("stability-map"))?;
     let p = out.join("stability-map.csv");
-    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", p.display()))?;
+    crate::outputs::write_atomically(&p, csv.as_bytes())
+        .map_err(|e| format!("{}: {e}", p.display()))?;
     files.push(p);
     Ok(files)
 }
@@ -420,7 +422,8 @@ pub fn separatrix(
     ));
     let mut files = svg_and_png(&c, &out.join("separatrix-error"))?;
     let p = out.join("separatrix-error.csv");
-    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", p.display()))?;
+    crate::outputs::write_atomically(&p, csv.as_bytes())
+        .map_err(|e| format!("{}: {e}", p.display()))?;
     files.push(p);
     Ok(files)
 }

@@ -277,7 +277,8 @@ pub fn long_horizon(
         ));
     }
     let path = base.with_extension("csv");
-    std::fs::write(&path, csv).map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::outputs::write_atomically(&path, csv.as_bytes())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     files.push(path);
     Ok(files)
 }

@@ -394,10 +394,12 @@ pub fn run(
         all.extend(points);
     }
     let path = out.join("work-precision.csv");
-    std::fs::write(&path, csv(&all)).map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::outputs::write_atomically(&path, csv(&all).as_bytes())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     files.push(path);
     let path = out.join("work-precision-references.csv");
-    std::fs::write(&path, notes).map_err(|e| format!("{}: {e}", path.display()))?;
+    crate::outputs::write_atomically(&path, notes.as_bytes())
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     files.push(path);
     Ok(files)
 }

@@ -55,6 +55,23 @@ pub(super) fn compare_cmd(
             }
         }
     }
+    // No output may be a scenario or another output (nothing runs otherwise).
+    let mut plan = crate::outputs::Plan::new();
+    for p in paths {
+        plan.input("the scenario", p);
+    }
+    for (what, p) in [("--chart", chart), ("--csv", csv), ("--json", json)] {
+        match p {
+            Some(p) if p != Path::new("-") => {
+                plan.output(what, p);
+            }
+            _ => {}
+        }
+    }
+    if let Err(e) = plan.check() {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
+    }
     let columns = crate::compare::Columns::new(&scenarios, &option_events);
     let interrupt = Arc::new(AtomicBool::new(false));
     {

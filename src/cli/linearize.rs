@@ -85,6 +85,16 @@ pub(super) fn linearize_cmd(path: &Path, json: Option<&Path>) -> i32 {
             return EXIT_BAD_INPUT;
         }
     };
+    if let Some(p) = json
+        && p != Path::new("-")
+        && let Err(e) = crate::outputs::Plan::new()
+            .input("the scenario", path)
+            .output("--json", p)
+            .check()
+    {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
+    }
     match json {
         Some(p) if p == Path::new("-") => println!("{}", analysis.json()),
         Some(p) => {

@@ -191,25 +191,12 @@ fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, i32> {
     })
 }
 
-/// Whether two paths name the same file (compared as absolute paths; neither need exist).
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (std::path::absolute(a), std::path::absolute(b)) {
-        (Ok(a), Ok(b)) => a == b || a.canonicalize().ok() == Some(b.clone()),
-        _ => a == b,
-    }
-}
-
 /// Checks up front that a file can be created at `path` (without leaving one behind).
 fn probe_writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
         return Err(std::io::Error::other("it is a directory"));
     }
     crate::log::check_replaceable(path)?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let tmp = dir.join(format!(".polhode-probe.{}.tmp", std::process::id()));
-    std::fs::File::create(&tmp)?;
-    std::fs::remove_file(&tmp)
+    let (_probe, _) = crate::outputs::TempFile::beside(path, "probe")?;
+    Ok(())
 }

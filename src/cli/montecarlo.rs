@@ -1,6 +1,6 @@
 //! `polhode montecarlo` and `polhode merge`: campaigns, whole or in shards.
 
-use super::{EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_IO, probe_writable};
+use super::{EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_IO};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -85,19 +85,31 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         None => 0..prep.campaign.runs,
     };
     let dir = out.unwrap_or_else(|| {
-        let base = PathBuf::from("logs").join(format!("{}-montecarlo", prep.scenario.name));
+        // The scenario's name is user text: one plain component, whatever it holds.
+        let suffix = "-montecarlo";
+        let name = crate::outputs::sanitize(&prep.scenario.name, suffix.len());
+        let base = PathBuf::from("logs").join(format!("{name}{suffix}"));
         match shard {
             Some([k, _]) => base.join(format!("shard-{k}")),
             None => base,
         }
     });
-    if let Err(e) = std::fs::create_dir_all(&dir).and_then(|()| probe_writable(&dir.join("x"))) {
-        eprintln!("error: cannot write to {}: {e}", dir.display());
-        return EXIT_BAD_INPUT;
-    }
-    // A previous campaign's files go first, so a run that dies leaves no stale manifest; the
-    // tables are then written as the runs finish.
-    let mut writer = match montecarlo::output::CampaignWriter::create(&dir, &prep, shard) {
+    // Nothing is written unless the directory may hold the outputs: not the scenario's,
+    // new, empty or polhode's, and no other campaign writing into it.
+    let owned = crate::outputs::Plan::new()
+        .input("the scenario", path)
+        .output_dir("--out", &dir)
+        .check()
+        .and_then(|()| montecarlo::output::claim(&dir));
+    let owned = match owned {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    // The tables are written as the runs finish.
+    let mut writer = match montecarlo::output::CampaignWriter::create(owned, &prep, shard) {
         Ok(w) => w,
         Err(e) => {
             eprintln!("error: {e}");
@@ -249,9 +261,24 @@ pub(super) fn merge_cmd(dirs: &[PathBuf], out: &Path, quiet: bool) -> i32 {
             return EXIT_BAD_INPUT;
         }
     };
+    let mut plan = crate::outputs::Plan::new();
+    for d in dirs {
+        plan.input("the shard", d);
+    }
+    let owned = match plan
+        .output_dir("--out", out)
+        .check()
+        .and_then(|()| montecarlo::output::claim(out))
+    {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     let interrupt = campaign_interrupt();
     WRITING_OUTPUTS.store(true, Ordering::SeqCst);
-    let (written, rows) = match shards.write(out, &interrupt) {
+    let (written, rows) = match shards.write(owned, &interrupt) {
         Ok(x) => x,
         Err(e) => {
             eprintln!(

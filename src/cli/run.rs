@@ -1,9 +1,7 @@
 //! `polhode run`: one scenario into its log, tables and summary.
 
 use super::summary::{print_summary, summary_json};
-use super::{
-    EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_IO, load, probe_writable, same_file,
-};
+use super::{EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_IO, load, probe_writable};
 use crate::log::{McapLogger, write_atomically};
 use crate::scenario::Overrides;
 use crate::sim::{self, Control, NullSink, Status};
@@ -34,14 +32,21 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
-    if let Some(p) = summary_path
-        && !no_log
-        && same_file(p, &s.mcap_path)
-    {
-        eprintln!(
-            "error: --summary {} is the log's own path; give the summary another name",
-            p.display()
-        );
+    // No output may be the scenario or another output (nothing is written otherwise).
+    let mut plan = crate::outputs::Plan::new();
+    plan.input("the scenario", path);
+    for (what, p) in [
+        ("--summary", summary_path),
+        ("--csv", outputs.csv),
+        ("--parquet", outputs.parquet),
+        ("the log", (!no_log).then_some(s.mcap_path.as_path())),
+    ] {
+        if let Some(p) = p {
+            plan.output(what, p);
+        }
+    }
+    if let Err(e) = plan.check() {
+        eprintln!("error: {e}");
         return EXIT_BAD_INPUT;
     }
     if let Some(p) = summary_path
@@ -49,27 +54,6 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
     {
         eprintln!("error: cannot write the summary to {}: {e}", p.display());
         return EXIT_BAD_INPUT;
-    }
-    // No two outputs may be the same file.
-    let named: Vec<(&str, &Path)> = [
-        ("--summary", summary_path),
-        ("--csv", outputs.csv),
-        ("--parquet", outputs.parquet),
-        ("the log", (!no_log).then_some(s.mcap_path.as_path())),
-    ]
-    .into_iter()
-    .filter_map(|(what, p)| p.map(|p| (what, p)))
-    .collect();
-    for (i, (a, pa)) in named.iter().enumerate() {
-        for (b, pb) in &named[i + 1..] {
-            if same_file(pa, pb) {
-                eprintln!(
-                    "error: {a} and {b} both name {}; give each output its own file",
-                    pa.display()
-                );
-                return EXIT_BAD_INPUT;
-            }
-        }
     }
     let mut table = if outputs.csv.is_some() || outputs.parquet.is_some() {
         match crate::log::samples::SampleTable::create(&s.spacecraft, outputs.csv, outputs.parquet)

@@ -95,6 +95,7 @@ fn decode_doubles(data: &[u8], out: &mut [f64]) -> Result<(), String> {
 
 /// Reads the telemetry and effector channels of the log at `path`.
 pub fn read(path: &Path) -> Result<RunLog, String> {
+    crate::outputs::note_input(path);
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let not_a_log = |e: mcap::McapError| {
         format!(
@@ -270,11 +271,20 @@ pub fn charts(log: &RunLog) -> Vec<(String, Chart)> {
     out
 }
 
-/// Writes the charts of `log` into `dir` as SVG and PNG; returns the files written.
-pub fn write(log: &RunLog, dir: &Path) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+/// Whether `plot` may write a file named `name` (a chart: SVG or PNG).
+pub fn may_write(name: &str) -> bool {
+    name.ends_with(".svg") || name.ends_with(".png")
+}
+
+/// Writes the charts of `log` as SVG and PNG into `owned` (claimed with [`may_write`]);
+/// returns the files written.
+pub fn write(log: &RunLog, mut owned: crate::outputs::OwnedDir) -> Result<Vec<PathBuf>, String> {
+    let dir = owned.dir().to_path_buf();
     let mut written = Vec::new();
     for (stem, chart) in charts(log) {
+        let stem = crate::outputs::sanitize(&stem, ".svg".len());
+        owned.file(&format!("{stem}.svg"))?;
+        owned.file(&format!("{stem}.png"))?;
         written.extend(crate::plot::svg_and_png(&chart, &dir.join(stem))?);
     }
     Ok(written)

@@ -29,7 +29,7 @@ use nalgebra::{UnitQuaternion, Vector3};
 use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{self, BufWriter, Write as _};
+use std::io::{self, BufWriter};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -98,47 +98,7 @@ struct Channels {
     orbit_scene: Option<u16>,
 }
 
-/// A temporary file that is removed when dropped (on errors and panics alike) unless it was
-/// kept by renaming it to its final name.
-pub(crate) struct TempFile {
-    path: PathBuf,
-    keep: bool,
-}
-
-impl TempFile {
-    /// Creates the hidden temporary file `.<name>.<pid>.tmp` beside `target` (`name` its
-    /// file name, or `default_name`), in `target`'s directory, which must exist.
-    pub(crate) fn beside(target: &Path, default_name: &str) -> io::Result<(TempFile, File)> {
-        let dir = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let file_name = target
-            .file_name()
-            .map(|f| f.to_string_lossy().into_owned())
-            .unwrap_or_else(|| default_name.into());
-        let temp = TempFile {
-            path: dir.join(format!(".{file_name}.{}.tmp", std::process::id())),
-            keep: false,
-        };
-        let file = File::create(&temp.path)?;
-        Ok((temp, file))
-    }
-
-    pub(crate) fn persist(mut self, to: &Path) -> io::Result<()> {
-        std::fs::rename(&self.path, to)?;
-        self.keep = true;
-        Ok(())
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if !self.keep {
-            let _ = std::fs::remove_file(&self.path);
-        }
-    }
-}
+pub(crate) use crate::outputs::TempFile;
 
 /// Static drawing parameters, fixed at the start of the run.
 struct SceneStyle {
@@ -1007,45 +967,7 @@ impl Sink for McapLogger<'_> {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    check_replaceable(path)?;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(with_hint)
-}
-
-/// Refuses to replace anything but a regular file: outputs are renamed into place, which
-/// would swap a device (`/dev/null`, `/dev/full`), FIFO or socket for a plain file.
-pub fn check_replaceable(path: &Path) -> io::Result<()> {
-    match std::fs::metadata(path) {
-        Ok(m) if !m.is_file() => Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            format!(
-                "{} exists and is not a regular file (a directory, device, FIFO or socket); \
-                 outputs replace files by renaming, so give a file path",
-                path.display()
-            ),
-        )),
-        _ => Ok(()),
-    }
-}
+pub use crate::outputs::{check_replaceable, write_atomically};
 
 /// Adds what to do to an out-of-space error (disk full, quota, file-size limit), keeping its
 /// kind.

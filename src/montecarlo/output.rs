@@ -5,13 +5,16 @@
 //! scenario as given), and for a whole campaign (not a shard) the charts (three for each
 //! event, named after its column, and the flat spin's under their historical names too) and
 //! `campaign.mcap`. `campaign.json`, the manifest, is written last: a directory without it
-//! holds no finished result. Every file is written under a temporary name and renamed.
+//! holds no finished result. Every file is written under a temporary name and renamed, into
+//! a directory taken through [`OwnedDir`] (new, empty, or polhode's; locked while written;
+//! only the files its marker lists are removed).
 
 use super::runs::{RunStore, Runs};
 use super::summary::{self, ColumnStats, EventStats, Failure, Ranking, StatusCounts, Tally};
 use super::table::{self, CsvWriter, ParquetWriter, Row};
 use super::{Prepared, sha256_hex, shard_range};
-use crate::log::{Attachment, McapLogger, write_atomically};
+use crate::log::{Attachment, McapLogger};
+use crate::outputs::{OwnedDir, TempFile, check_replaceable, temporary_path, write_atomically};
 use crate::plot::{Chart, Series, Style};
 use crate::scenario::{self, Overrides};
 use crate::sim::{self, Control};
@@ -29,9 +32,7 @@ pub const MANIFEST_FORMAT: &str = "polhode-campaign/1";
 /// Hash of the sources and `Cargo.lock` this binary was built from (build.rs).
 pub const BUILD_ID: &str = env!("POLHODE_BUILD_ID");
 
-/// Every file name a campaign may write, the manifest first: removed before writing, so a
-/// directory never mixes the files of two campaigns and never shows a manifest while its
-/// files are being replaced.
+/// Every fixed file name a campaign may write.
 const OUTPUT_FILES: [&str; 13] = [
     "campaign.json",
     "runs.csv",
@@ -66,52 +67,18 @@ fn is_event_chart(name: &str) -> bool {
         && EVENT_CHART_SUFFIXES.iter().any(|s| stem.ends_with(s))
 }
 
-/// Whether `name` is a temporary name ([`temporary_name`]) of a campaign's file.
-fn is_temporary(name: &str) -> bool {
-    let Some(rest) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
-        return false;
-    };
-    let Some((file, pid)) = rest.rsplit_once('.') else {
-        return false;
-    };
-    !pid.is_empty()
-        && pid.bytes().all(|b| b.is_ascii_digit())
-        && (file == SCRATCH_FILE || OUTPUT_FILES.contains(&file) || is_event_chart(file))
+/// Whether a campaign may write a file named `name`: a directory holding such a file that
+/// polhode did not write is refused ([`OwnedDir::claim`]).
+pub fn may_write(name: &str) -> bool {
+    OUTPUT_FILES.contains(&name) || is_event_chart(name)
 }
 
 /// The scratch file of the runs' values, under its temporary name while a campaign writes.
 const SCRATCH_FILE: &str = "runs.scratch";
 
-/// Removes a previous campaign's outputs from `dir` (the manifest first).
-pub fn clear_outputs(dir: &Path) -> Result<(), String> {
-    let remove = |p: PathBuf| match std::fs::remove_file(&p) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(format!("cannot remove the old {}: {e}", p.display())),
-    };
-    for name in OUTPUT_FILES {
-        remove(dir.join(name))?;
-    }
-    // The event charts, whose names come from the previous campaign's events.
-    let entries = match std::fs::read_dir(dir) {
-        Ok(entries) => entries,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
-        Err(e) => return Err(format!("cannot list {}: {e}", dir.display())),
-    };
-    // And the temporaries of a campaign that was killed while it wrote (`.<file>.<pid>.tmp`).
-    let mut old: Vec<PathBuf> = entries
-        .filter_map(Result::ok)
-        .filter(|e| {
-            let name = e.file_name().to_string_lossy().into_owned();
-            is_event_chart(&name) || is_temporary(&name)
-        })
-        .map(|e| e.path())
-        .collect();
-    old.sort();
-    for p in old {
-        remove(p)?;
-    }
-    Ok(())
+/// Takes `dir` for a campaign's outputs ([`OwnedDir::claim`] with [`may_write`]).
+pub fn claim(dir: &Path) -> Result<OwnedDir, String> {
+    OwnedDir::claim(dir, &may_write)
 }
 
 /// What [`write_outputs`] wrote.
@@ -186,14 +153,15 @@ struct SummaryDoc {
 /// not grow with the number of runs. [`CampaignWriter::finish`] writes the rest; dropped
 /// before that, it leaves nothing behind.
 pub struct CampaignWriter<'a> {
-    dir: PathBuf,
+    dir: OwnedDir,
     prep: &'a Prepared,
     shard: Option<[u64; 2]>,
     /// The open writers (taken by `finish`).
     open: Option<OpenTables>,
     tally: Tally,
-    /// Temporary and final names of the tables, removed on drop until renamed.
-    temporary: Vec<(PathBuf, PathBuf)>,
+    /// The tables under their temporary names (removed on drop until renamed), and their
+    /// final names.
+    temporary: Vec<(TempFile, PathBuf)>,
     /// Threads `finish` may use ([`CampaignWriter::use_threads`]).
     threads: usize,
 }
@@ -205,55 +173,33 @@ struct OpenTables {
     store: RunStore,
 }
 
-/// A temporary name in `dir` for the file `name`.
-fn temporary_name(dir: &Path, name: &str) -> PathBuf {
-    dir.join(format!(".{name}.{}.tmp", std::process::id()))
-}
-
 impl<'a> CampaignWriter<'a> {
-    /// Removes a previous campaign's outputs from `dir` (created if needed) and starts
-    /// writing this one's (`shard`: which shard, or `None` for a whole campaign).
-    pub fn create(dir: &Path, prep: &'a Prepared, shard: Option<[u64; 2]>) -> Result<Self, String> {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-        clear_outputs(dir)?;
-        let open = |name: &str| -> Result<(BufWriter<File>, (PathBuf, PathBuf)), String> {
-            let target = dir.join(name);
-            crate::log::check_replaceable(&target)
+    /// Starts writing a campaign's outputs into `dir` ([`claim`]; `shard`: which shard, or
+    /// `None` for a whole campaign).
+    pub fn create(
+        mut dir: OwnedDir,
+        prep: &'a Prepared,
+        shard: Option<[u64; 2]>,
+    ) -> Result<Self, String> {
+        let mut open = |name: &str| -> Result<(BufWriter<File>, (TempFile, PathBuf)), String> {
+            let target = dir.file(name)?;
+            check_replaceable(&target)
                 .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
-            let tmp = temporary_name(dir, name);
-            let f = File::create(&tmp)
+            let (tmp, f) = TempFile::beside(&target, name)
                 .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
             Ok((BufWriter::with_capacity(1 << 20, f), (tmp, target)))
         };
         let (csv_file, csv_names) = open("runs.csv")?;
-        let (parquet_file, parquet_names) = match open("runs.parquet") {
-            Ok(x) => x,
-            Err(e) => {
-                let _ = std::fs::remove_file(&csv_names.0);
-                return Err(e);
-            }
-        };
-        let mut temporary = vec![csv_names, parquet_names];
-        let result = (|| {
-            let io = |e: std::io::Error| format!("cannot write runs.csv: {e}");
-            let csv = CsvWriter::new(csv_file, &prep.columns).map_err(io)?;
-            let parquet = ParquetWriter::new(parquet_file, &prep.columns)
-                .map_err(|e| format!("cannot write runs.parquet: {e}"))?;
-            let store = RunStore::create(&temporary_name(dir, SCRATCH_FILE), prep.columns.len())?;
-            Ok::<_, String>((csv, parquet, store))
-        })();
-        let (csv, parquet, store) = match result {
-            Ok(x) => x,
-            Err(e) => {
-                for (tmp, _) in temporary.drain(..) {
-                    let _ = std::fs::remove_file(tmp);
-                }
-                return Err(e);
-            }
-        };
+        let (parquet_file, parquet_names) = open("runs.parquet")?;
+        let temporary = vec![csv_names, parquet_names];
+        let scratch = temporary_path(&dir.file(SCRATCH_FILE)?, SCRATCH_FILE);
+        let io = |e: std::io::Error| format!("cannot write runs.csv: {e}");
+        let csv = CsvWriter::new(csv_file, &prep.columns).map_err(io)?;
+        let parquet = ParquetWriter::new(parquet_file, &prep.columns)
+            .map_err(|e| format!("cannot write runs.parquet: {e}"))?;
+        let store = RunStore::create(&scratch, prep.columns.len())?;
         Ok(Self {
-            dir: dir.to_path_buf(),
+            dir,
             prep,
             shard,
             open: Some(OpenTables {
@@ -272,15 +218,18 @@ impl<'a> CampaignWriter<'a> {
         let Some(open) = self.open.as_mut() else {
             return Err("the campaign's tables are already closed".into());
         };
-        open.csv
-            .push(&row)
-            .map_err(|e| format!("cannot write {}: {e}", self.dir.join("runs.csv").display()))?;
+        open.csv.push(&row).map_err(|e| {
+            format!(
+                "cannot write {}: {e}",
+                self.dir.dir().join("runs.csv").display()
+            )
+        })?;
         open.store.push(&row)?;
         self.tally.add(&row);
         open.parquet.push(row).map_err(|e| {
             format!(
                 "cannot write {}: {e}",
-                self.dir.join("runs.parquet").display()
+                self.dir.dir().join("runs.parquet").display()
             )
         })
     }
@@ -301,8 +250,8 @@ impl<'a> CampaignWriter<'a> {
     /// best runs, which are re-run: if `interrupt` is set meanwhile, the MCAP is left out and
     /// everything else is still written. The manifest comes last.
     pub fn finish(mut self, partial: bool, interrupt: &AtomicBool) -> Result<Written, String> {
-        let dir = self.dir.clone();
         let mut written = Vec::new();
+        let dir = self.dir.dir().to_path_buf();
         let fail = |name: &str, e: &dyn std::fmt::Display| {
             format!("cannot write {}: {e}", dir.join(name).display())
         };
@@ -319,41 +268,51 @@ impl<'a> CampaignWriter<'a> {
         let file = parquet.finish().map_err(|e| fail("runs.parquet", &e))?;
         sync(file).map_err(|e| fail("runs.parquet", &e))?;
         for (tmp, target) in std::mem::take(&mut self.temporary) {
-            let name = target.display().to_string();
-            if let Err(e) = std::fs::rename(&tmp, &target) {
-                let _ = std::fs::remove_file(&tmp);
-                return Err(format!("cannot write {name}: {e}"));
-            }
+            tmp.persist(&target)
+                .map_err(|e| format!("cannot write {}: {e}", target.display()))?;
             written.push(target);
         }
-        let put = |written: &mut Vec<PathBuf>, name: &str, bytes: &[u8]| -> Result<(), String> {
-            let p = dir.join(name);
+        let put = |owned: &mut OwnedDir,
+                   written: &mut Vec<PathBuf>,
+                   name: &str,
+                   bytes: &[u8]|
+         -> Result<(), String> {
+            let p = owned.file(name)?;
             write_atomically(&p, bytes)
                 .map_err(|e| format!("cannot write {}: {e}", p.display()))?;
             written.push(p);
             Ok(())
         };
         let prep = self.prep;
+        let owned = &mut self.dir;
         put(
+            owned,
             &mut written,
             "scenario.yaml",
             prep.scenario.source.as_bytes(),
         )?;
         let runs = store.finish()?;
-        let manifest = manifest(prep, self.rows(), self.shard, partial, sha);
+        let rows = self.tally.runs() as u64;
+        let manifest = manifest(prep, rows, self.shard, partial, sha);
         let stats = summary::statistics(&self.tally, &runs)?;
         let plan = chart_plan(prep, &self.tally, self.shard);
         let doc = summary_doc(&manifest, stats, plan);
         let json = serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())? + "\n";
-        put(&mut written, "summary.json", json.as_bytes())?;
-        put(&mut written, "summary.txt", summary_text(&doc).as_bytes())?;
+        put(owned, &mut written, "summary.json", json.as_bytes())?;
+        put(
+            owned,
+            &mut written,
+            "summary.txt",
+            summary_text(&doc).as_bytes(),
+        )?;
         let mut mcap_interrupted = false;
         if self.shard.is_none() {
-            written.extend(charts(&dir, prep, &runs, &doc)?);
+            written.extend(charts(owned, prep, &runs, &doc)?);
             if let Some(r) = &doc.ranking
                 && !partial
             {
-                match trajectories(&dir, prep, r, &json, interrupt, self.threads)? {
+                let path = owned.file("campaign.mcap")?;
+                match trajectories(&path, prep, r, &json, interrupt, self.threads)? {
                     Some(p) => written.push(p),
                     None => mcap_interrupted = true,
                 }
@@ -361,19 +320,11 @@ impl<'a> CampaignWriter<'a> {
         }
         drop(runs);
         let m = serde_json::to_string_pretty(&manifest).map_err(|e| e.to_string())? + "\n";
-        put(&mut written, "campaign.json", m.as_bytes())?;
+        put(owned, &mut written, "campaign.json", m.as_bytes())?;
         Ok(Written {
             files: written,
             mcap_interrupted,
         })
-    }
-}
-
-impl Drop for CampaignWriter<'_> {
-    fn drop(&mut self) {
-        for (tmp, _) in &self.temporary {
-            let _ = std::fs::remove_file(tmp);
-        }
     }
 }
 
@@ -383,7 +334,7 @@ fn sync(file: BufWriter<File>) -> std::io::Result<()> {
 }
 
 /// Writes every output of `rows` (the runs of the range that finished, in run order) into
-/// `dir`, as [`CampaignWriter`] does.
+/// `dir` ([`claim`]ed), as [`CampaignWriter`] does.
 pub fn write_outputs(
     dir: &Path,
     prep: &Prepared,
@@ -392,7 +343,7 @@ pub fn write_outputs(
     partial: bool,
     interrupt: &AtomicBool,
 ) -> Result<Written, String> {
-    let mut w = CampaignWriter::create(dir, prep, shard)?;
+    let mut w = CampaignWriter::create(claim(dir)?, prep, shard)?;
     for r in rows {
         w.push(r.clone())?;
     }
@@ -643,7 +594,7 @@ fn chart_plan(prep: &Prepared, tally: &Tally, shard: Option<[u64; 2]>) -> Vec<Ev
 
 /// Draws every event's charts as planned in `doc`.
 fn charts(
-    dir: &Path,
+    dir: &mut OwnedDir,
     prep: &Prepared,
     runs: &dyn Runs,
     doc: &SummaryDoc,
@@ -664,9 +615,11 @@ fn charts(
     for (p, d) in doc.charts.iter().zip(&data) {
         let drawn = d.charts(prep, !p.flat_spin.is_empty());
         for (k, chart) in drawn.iter().enumerate() {
-            let mut stems = vec![dir.join(&p.charts[k])];
-            if let Some(name) = p.flat_spin.get(k) {
-                stems.push(dir.join(name));
+            let mut stems = Vec::new();
+            for name in std::iter::once(&p.charts[k]).chain(p.flat_spin.get(k)) {
+                dir.file(&format!("{name}.svg"))?;
+                dir.file(&format!("{name}.png"))?;
+                stems.push(dir.dir().join(name));
             }
             let stems: Vec<&Path> = stems.iter().map(PathBuf::as_path).collect();
             out.extend(
@@ -871,7 +824,7 @@ impl EventChartData {
 /// integrated on a thread of their own while this one writes them (through a
 /// [`sim::Relay`]); the file is the same, byte for byte.
 fn trajectories(
-    dir: &Path,
+    path: &Path,
     prep: &Prepared,
     ranking: &Ranking,
     summary_json: &str,
@@ -887,7 +840,6 @@ fn trajectories(
     for (_, i) in picks {
         scenarios.push(prep.build_run(i).map_err(|e| format!("run {i}: {e}"))?.0);
     }
-    let path = dir.join("campaign.mcap");
     let control = || Control {
         interrupt,
         progress: None,
@@ -908,12 +860,12 @@ fn trajectories(
             });
             // `from_runs` is dropped on leaving, before the scope waits for the runs: a run
             // still sending then stops.
-            log_picks(&path, &picks, &scenarios, &mut |_, logger| {
+            log_picks(path, &picks, &scenarios, &mut |_, logger| {
                 sim::receive_run(&from_runs, logger)
             })
         })
     } else {
-        log_picks(&path, &picks, &scenarios, &mut |k, logger| {
+        log_picks(path, &picks, &scenarios, &mut |k, logger| {
             sim::run(&scenarios[k], logger, control())
         })
     };
@@ -1015,6 +967,9 @@ fn file_sha256(path: &Path) -> std::io::Result<String> {
 
 fn read_shard(dir: &Path) -> Result<ShardOutput, String> {
     let d = dir.display();
+    for name in ["campaign.json", "runs.csv", "scenario.yaml"] {
+        crate::outputs::note_input(&dir.join(name));
+    }
     let manifest_text = std::fs::read_to_string(dir.join("campaign.json"))
         .map_err(|e| format!("{d}: no finished campaign output here (campaign.json: {e})"))?;
     let manifest: Manifest = serde_json::from_str(&manifest_text)
@@ -1247,10 +1202,10 @@ impl ShardSet {
         Ok(())
     }
 
-    /// Writes the whole campaign's outputs into `out` (see [`CampaignWriter::finish`] for
+    /// Writes the whole campaign's outputs into `out` ([`claim`]ed; see [`CampaignWriter::finish`] for
     /// `interrupt`), reading the shards' rows once more. Returns what was written and the
     /// number of runs.
-    pub fn write(&self, out: &Path, interrupt: &AtomicBool) -> Result<(Written, u64), String> {
+    pub fn write(&self, out: OwnedDir, interrupt: &AtomicBool) -> Result<(Written, u64), String> {
         let mut writer = CampaignWriter::create(out, &self.prep, None)?;
         self.read_rows(&mut |row| writer.push(row))?;
         let runs = writer.rows();

@@ -47,10 +47,13 @@ pub struct RunStore {
 }
 
 impl RunStore {
-    /// Creates the scratch file `path` for runs with `columns` values.
+    /// Creates the scratch file `path` (a new name) for runs with `columns` values.
     pub fn create(path: &Path, columns: usize) -> Result<Self, String> {
-        let file =
-            File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+        let file = File::options()
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
         Ok(Self {
             path: path.to_path_buf(),
             out: BufWriter::with_capacity(1 << 20, file),

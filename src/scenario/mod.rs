@@ -361,6 +361,7 @@ pub struct Overrides {
 
 /// Reads and validates a scenario file.
 pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioError> {
+    crate::outputs::note_input(path);
     let meta = std::fs::metadata(path)
         .map_err(|e| ScenarioError::whole_file(path, format!("cannot read the file: {e}")))?;
     if meta.is_dir() {

@@ -160,21 +160,11 @@ pub(super) fn output_rate_hint(out: &Option<OutputSpec>) -> f64 {
 }
 
 /// Where a scenario's log goes unless `output.mcap` or `--mcap` says otherwise:
-/// `logs/<name>.mcap`, the name [`sanitize`]d.
+/// `logs/<name>.mcap`, the name made one plain file name ([`crate::outputs::sanitize`]).
 pub(super) fn default_log_path(name: &str) -> PathBuf {
-    PathBuf::from(format!("logs/{}.mcap", sanitize(name)))
-}
-
-/// The log file's default name: the scenario's name with anything but letters, digits, `-`
-/// and `_` turned into `-`.
-fn sanitize(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
-                c
-            } else {
-                '-'
-            }
-        })
-        .collect()
+    let suffix = ".mcap";
+    PathBuf::from("logs").join(format!(
+        "{}{suffix}",
+        crate::outputs::sanitize(name, suffix.len())
+    ))
 }
