@@ -196,3 +196,22 @@ fn every_run_is_checked_against_the_contract_whatever_built_it() {
         other => panic!("expected a refusal, got {other:?}"),
     }
 }
+
+#[test]
+fn gauss_converges_where_a_quaternion_component_stays_zero_by_symmetry() {
+    // An axisymmetric body turning about a transverse axis: ω is constant and q_z stays
+    // exactly zero, which the Newton iteration approached geometrically without ever meeting
+    // its relative test (found by the `method_pairs` fuzz target).
+    let yaml = "name: t\nbody: {principal: [1, 1, 1.85]}\n\
+                initial: {omega: [-0.03125, 1.15625, 0]}\nduration: 0.2\n";
+    for stages in [1, 2] {
+        let ov = Overrides {
+            method: Some("gauss".into()),
+            dt: Some(0.005),
+            stages: Some(stages),
+            ..Overrides::default()
+        };
+        let (out, _) = run(&scenario_with(yaml, &ov));
+        assert_eq!(out.status, Status::Complete, "{stages} stage(s)");
+    }
+}

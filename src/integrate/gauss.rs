@@ -127,8 +127,9 @@ impl GaussStages {
 /// **Stopping rule.** Each iteration evaluates `kᵢ = f(tₙ + cᵢh, yₙ + Zᵢ)`, solves for the
 /// increment `ΔZ` and applies it. The iteration is converged when
 /// * every increment is within a couple of ulps of its stage value,
-///   `|ΔZᵢⱼ| ≤ 2ε max(|Yᵢⱼ|, |Zᵢⱼ|)` (`Zᵢⱼ` too because `Yᵢⱼ = yₙⱼ + Zᵢⱼ` can be near zero by
-///   cancellation, as in a stiff decay), or
+///   `|ΔZᵢⱼ| ≤ 2ε max(|Yᵢⱼ|, |Zᵢⱼ|, ε‖yₙ‖∞)` (`Zᵢⱼ` too because `Yᵢⱼ = yₙⱼ + Zᵢⱼ` can be near
+///   zero by cancellation, as in a stiff decay; the last term resolves a component whose
+///   solution is exactly zero, which the iteration approaches geometrically), or
 /// * the increment stops decreasing (`‖ΔZ‖ ≥ ‖ΔZ_prev‖`, norm-wise
 ///   `max|ΔZ| / max(|Y|, |Z|)`) while below 1e-13: the roundoff floor (a component passing
 ///   through zero never reaches the first test).
@@ -363,6 +364,12 @@ impl Gauss {
         let m = s * n;
         let mut prev = f64::INFINITY;
         let mut rate_max: f64 = 0.0;
+        // A stage component below the rounding of the state's largest component, ε |yₙ|∞,
+        // is resolved at that floor: a component whose solution is exactly zero (a quaternion
+        // component that stays zero by symmetry) is approached geometrically by the iteration,
+        // its increment always about the size of the last value, and would otherwise never
+        // meet the relative test nor stagnate (found by the `method_pairs` fuzz target).
+        let floor = f64::EPSILON * self.y.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
         for it in 0..MAX_ITERATIONS {
             for i in 0..s {
                 let zi = &self.z[i * n..(i + 1) * n];
@@ -410,7 +417,7 @@ impl Gauss {
                     y_max = y_max.max(scale);
                     // Never true for a nonzero increment to a zero stage: left to the
                     // stagnation test.
-                    converged &= d.abs() <= CONVERGED_RELATIVE * scale;
+                    converged &= d.abs() <= CONVERGED_RELATIVE * scale.max(floor);
                 }
             }
             if !d_max.is_finite() || !y_max.is_finite() {
