@@ -360,10 +360,25 @@ const COLLAPSE_WINDOW: u64 = 10_000;
 /// Where the next step must end at the latest: the run's end, or the first breakpoint of an
 /// effector after `t` (a commanded torque's step), where the right-hand side jumps and the
 /// integrator stops exactly and restarts ([`Stepper::restart`]).
+///
+/// Breakpoints a few ulps apart (a tick k·Δt and a step time m/f that are the same instant in
+/// exact arithmetic) are one stop, at the latest of them, where every effector takes its new
+/// value; a breakpoint within a few ulps of the end is the end
+/// ([`crate::integrate::same_instant`]). Otherwise the step between them would be below the
+/// resolution of t and an adaptive method would fail with a step-size underflow.
 fn next_stop(sc: &crate::model::Spacecraft, t: f64, t_end: f64) -> f64 {
-    match sc.next_breakpoint(t) {
-        Some(b) if b < t_end => b,
-        _ => t_end,
+    let Some(mut b) = sc.next_breakpoint(t) else {
+        return t_end;
+    };
+    while let Some(next) = sc.next_breakpoint(b)
+        && crate::integrate::same_instant(b, next)
+    {
+        b = next;
+    }
+    if b >= t_end || crate::integrate::same_instant(b, t_end) {
+        t_end
+    } else {
+        b
     }
 }
 
