@@ -44,6 +44,45 @@ pub const BLOCK_RUNS: u64 = 4096;
 /// (see `Prepared::longest_first`).
 pub const ORDERED_RUNS_PER_THREAD: usize = 32;
 
+/// Worker threads allowed per logical core: a campaign asking for more threads than
+/// [`max_threads`] gets that many. Threads beyond the cores only add contention (rayon's own
+/// default is one per logical core), and a pool of 10⁵ threads takes minutes to start, during
+/// which nothing answers Ctrl-C or SIGTERM.
+pub const THREADS_PER_CORE: usize = 4;
+
+/// The logical cores of this machine (1 when unknown).
+pub fn logical_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}
+
+/// The most worker threads a campaign uses: [`THREADS_PER_CORE`] × the logical cores.
+pub fn max_threads() -> usize {
+    THREADS_PER_CORE * logical_cores()
+}
+
+/// The worker threads for a requested count (`None`: one per logical core), with a note when
+/// the request was above [`max_threads`] and was capped; `what` names the option in messages
+/// (`--threads`, `threads`). `Err` for 0.
+pub fn thread_count(
+    requested: Option<usize>,
+    what: &str,
+) -> Result<(usize, Option<String>), String> {
+    let cap = max_threads();
+    match requested {
+        None => Ok((logical_cores(), None)),
+        Some(0) => Err(format!("{what}: expected at least 1, got 0")),
+        Some(t) if t > cap => Ok((
+            cap,
+            Some(format!(
+                "{what} {t}: capped at {cap} ({THREADS_PER_CORE} × {} logical cores); more \
+                 threads than cores only add contention",
+                logical_cores()
+            )),
+        )),
+        Some(t) => Ok((t, None)),
+    }
+}
+
 /// A run as [`Prepared::build_run`] builds it.
 type Built = Result<(Scenario, Vec<f64>), InvalidDraw>;
 
@@ -495,7 +534,7 @@ impl Prepared {
         consume: &mut dyn FnMut(Row) -> Result<(), String>,
     ) -> Result<bool, String> {
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
+            .num_threads(threads.clamp(1, max_threads()))
             .build()
             .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
         let mut partial = false;
