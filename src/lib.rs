@@ -127,6 +127,7 @@ pub mod model;
 pub mod montecarlo;
 pub mod orbit;
 pub mod plot;
+pub mod resources;
 pub mod scenario;
 pub mod sim;
 pub mod sincos;
