@@ -6,6 +6,7 @@
 //! [`Scenario`] ready to run.
 
 mod body;
+mod bounds;
 pub mod campaign;
 mod effectors;
 mod error;
@@ -436,7 +437,11 @@ pub fn parse(
         Ok(f) => f,
         Err(e) => return Err(yaml_error(path, &source, &e)),
     };
-    file.validate(path, source, overrides)
+    // Plausible physical bounds on every number, after the field checks (whose messages
+    // say more about the fields they know).
+    let bounded = bounds::check(path, &source);
+    let scenario = file.validate(path, source, overrides)?;
+    bounded.map(|()| scenario)
 }
 
 /// Turns a YAML-layer error into a located [`ScenarioError`] with a suggestion for misspelt keys.
@@ -676,6 +681,14 @@ pub(crate) fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
     Some((s.referenced.line() as u32, s.referenced.column() as u32))
 }
 
+/// `v` over its length, or `None` for a zero or non-finite vector. Scaled by its largest
+/// component first, so that [1e200, 1e200, 0] does not overflow to an infinite length and
+/// [1e-300, 1e-300, 0] does not underflow to a zero one.
+pub fn unit_vector(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let m = v.amax();
+    (v.iter().all(|x| x.is_finite()) && m > 0.0).then(|| (v / m).normalize())
+}
+
 fn finite3(v: &[f64; 3]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
@@ -830,15 +843,14 @@ impl ScenarioFile {
         // Spin axis: given, or the principal axis closest to the initial angular momentum.
         let spin_axis = match &self.body.spin_axis {
             Some(s) => {
-                let v = Vector3::from(s.value);
-                if !finite3(&s.value) || v.norm() == 0.0 {
+                let Some(v) = unit_vector(&Vector3::from(s.value)) else {
                     return Err(err(
                         loc(s),
                         "body.spin_axis",
                         "expected a non-zero vector of three finite numbers (body axes)".into(),
                     ));
-                }
-                v.normalize()
+                };
+                v
             }
             None => default_spin_axis(&hub, &omega0),
         };
@@ -1435,10 +1447,9 @@ fn shape(path: &Path, s: &Spanned<ShapeSpec>) -> Result<Shape, ScenarioError> {
             if !positive(*radius) || !positive(*length) {
                 return Err(bad("expected a positive radius and length (m)"));
             }
-            let axis = Vector3::from(axis.unwrap_or([0.0, 0.0, 1.0]));
-            if !axis.iter().all(|x| x.is_finite()) || axis.norm() == 0.0 {
+            let Some(axis) = unit_vector(&Vector3::from(axis.unwrap_or([0.0, 0.0, 1.0]))) else {
                 return Err(bad("expected a non-zero cylinder axis"));
-            }
+            };
             let orientation = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
                 .unwrap_or_else(|| {
                     UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)
