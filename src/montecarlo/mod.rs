@@ -164,12 +164,14 @@ impl Prepared {
         const QUOTE: &str = "a text value in this scenario reads as a number (e.g. `name: 1e2`, \
                              `name: 0x1F`, `name: .nan`); quote it (`name: \"1e2\"`) to run a \
                              campaign";
-        let mut tree: Value = serde_saphyr::from_str(&scenario.source).map_err(|e| {
-            let first = e.without_snippet().to_string();
-            let first = first.lines().next().unwrap_or("").to_string();
-            let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
-            ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
-        })?;
+        let mut tree: Value =
+            serde_saphyr::from_str_with_options(&scenario.source, crate::scenario::yaml_options())
+                .map_err(|e| {
+                    let first = e.without_snippet().to_string();
+                    let first = first.lines().next().unwrap_or("").to_string();
+                    let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+                    ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
+                })?;
         if let Some(map) = tree.as_object_mut() {
             map.remove("montecarlo");
         }
