@@ -13,7 +13,9 @@
 //!   Students*, ch. 3–4): `M = M₀ + Ṁ t`, Kepler's equation `E − e sin E = M` ([`kepler`]),
 //!   perifocal position `a(cos E − e) P̂ + a√(1−e²) sin E Q̂`, velocity
 //!   `(√(μa)/r)(−sin E P̂ + √(1−e²) cos E Q̂)`, `r = a(1 − e cos E)`, with the perifocal axes
-//!   `[P̂ Q̂ Ŵ] = R3(−Ω) R1(−i) R3(−ω)`.
+//!   `[P̂ Q̂ Ŵ] = R3(−Ω) R1(−i) R3(−ω)`. `cos E − e` and `1 − e cos E` are formed as
+//!   `(1 − e) − (1 − cos E)` and `(1 − e) + e(1 − cos E)` with `1 − cos E = 2 sin²(E/2)`,
+//!   which keep their digits as `e → 1` near perigee, where `cos E` rounds to 1.
 //! - Optional secular J2 drift ([`Orbit::new`] with `j2_secular`): Ω, ω and M advance at
 //!   the first-order secular rates (Vallado §9.6), and the state is formed from the
 //!   drifted elements as in Vallado's PKEPLER algorithm (§9.6). The velocity is then the
