@@ -230,3 +230,74 @@ fn an_unstable_sampled_loop_is_blamed_on_the_controller() {
     assert!(unreadable(&err).is_none(), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A full disk while writing `--csv` with `--no-log` names the table, not the log (before:
+/// "writing the log failed"). RLIMIT_FSIZE makes writes past 20 kB fail as on a full disk.
+#[test]
+fn a_full_disk_under_csv_alone_names_the_table() {
+    use std::os::unix::process::CommandExt;
+    let dir = scratch("csv-full");
+    let csv = dir.join("t.csv");
+    let mut cmd = polhode();
+    cmd.args([
+        "run",
+        concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenarios/rwa-rate-damping.yaml"
+        ),
+        "--no-log",
+        "-q",
+        "--csv",
+    ])
+    .arg(&csv);
+    // SAFETY: setrlimit is async-signal-safe and touches only the child being started.
+    unsafe {
+        cmd.pre_exec(|| {
+            let limit = libc::rlimit {
+                rlim_cur: 20_000,
+                rlim_max: 20_000,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &limit) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let out = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("writing the sampled telemetry"), "{err}");
+    assert!(err.contains("t.csv"), "{err}");
+    assert!(!err.contains("the log"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A NaN in `probability_by` is a non-finite number at its field, not "text that reads as a
+/// number".
+#[test]
+fn a_nan_in_probability_by_is_called_not_finite() {
+    let dir = scratch("nan");
+    let file = dir.join("nan.yaml");
+    let yaml = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/explorer1-energy-sink.yaml"
+    ))
+    .unwrap()
+    .replace(
+        "probability_by: [3600, 6888, 14400]",
+        "probability_by: [3600, .nan]",
+    );
+    std::fs::write(&file, yaml).unwrap();
+    let out = polhode()
+        .args(["montecarlo", file.to_str().unwrap(), "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("field `montecarlo.probability_by`: expected a finite number, got `.nan`"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

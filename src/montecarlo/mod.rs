@@ -170,6 +170,38 @@ impl Prepared {
                     let first = e.without_snippet().to_string();
                     let first = first.lines().next().unwrap_or("").to_string();
                     let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+                    // A number that is not finite (`.nan`, `.inf`) where a number is expected
+                    // (`probability_by: [.nan]`) is that, not text reading as a number.
+                    let line = location.and_then(|(l, _)| {
+                        crate::scenario::yaml_line(&scenario.source, l).map(|t| (l, t))
+                    });
+                    if let Some((l, text)) = line {
+                        let lower = text.to_ascii_lowercase();
+                        let key = lower
+                            .split(':')
+                            .next()
+                            .unwrap_or("")
+                            .trim()
+                            .trim_start_matches("- ");
+                        if key != "name"
+                            && let Some(k) = [".nan", ".inf", "-.inf", "+.inf"]
+                                .iter()
+                                .filter_map(|w| lower.find(w))
+                                .min()
+                        {
+                            let column = text[..k].chars().count() as u32 + 1;
+                            let word: String = text[k..]
+                                .chars()
+                                .take_while(|c| !matches!(c, ',' | ']' | '}' | ' '))
+                                .collect();
+                            return ScenarioError::at(
+                                &path,
+                                Some((l, column)),
+                                crate::scenario::field_path_at(&scenario.source, l, column),
+                                format!("expected a finite number, got `{word}`"),
+                            );
+                        }
+                    }
                     ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
                 })?;
         if let Some(map) = tree.as_object_mut() {

@@ -427,6 +427,13 @@ pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioErro
     parse(path, source, overrides)
 }
 
+/// Line `line` (1-based) of `source`, as YAML counts lines.
+pub fn yaml_line(source: &str, line: u32) -> Option<&str> {
+    error::yaml_lines(source)
+        .get(line.checked_sub(1)? as usize)
+        .copied()
+}
+
 /// How scenario text is read: YAML 1.2 core booleans only (`true`/`false`), so that `yes`,
 /// `on`, `'y'` or `'off'` are strings, as YAML 1.2 says, and a boolean key refuses them.
 pub fn yaml_options() -> serde_saphyr::Options {
