@@ -128,6 +128,7 @@ pub mod montecarlo;
 pub mod orbit;
 pub mod outputs;
 pub mod plot;
+pub mod resources;
 pub mod scenario;
 pub mod sim;
 pub mod sincos;

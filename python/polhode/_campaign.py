@@ -180,7 +180,7 @@ def montecarlo(
     --shard K/N`` (any thread count gives the same numbers).
 
     - ``runs``, ``seed``: override the block's; ``threads``: worker threads (default: every
-      core); ``shard``: ``"K/N"`` or ``(K, N)``, 1 <= K <= N, to run only the K-th of N
+      core; more than 4 per logical core are capped there, with a ``RuntimeWarning``); ``shard``: ``"K/N"`` or ``(K, N)``, 1 <= K <= N, to run only the K-th of N
       contiguous slices of the runs, as ``--shard`` does.
     - ``progress``: None (default) shows a tqdm bar when stderr is a terminal or in a
       Jupyter kernel and tqdm is installed, nothing otherwise; True always (needs tqdm);

@@ -5,7 +5,7 @@ use crate::errors::{internal_error, scenario_error};
 use crate::py_scenario::PyScenario;
 use polhode::montecarlo;
 use polhode::scenario::{self, Overrides};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyRuntimeWarning, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -50,11 +50,13 @@ pub(crate) fn _montecarlo(
             )));
         }
     }
-    let threads = match threads {
-        Some(0) => return Err(PyValueError::new_err("threads: expected at least 1")),
-        Some(t) => t,
-        None => std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get),
-    };
+    let (threads, note) =
+        montecarlo::thread_count(threads, "threads").map_err(PyValueError::new_err)?;
+    if let Some(note) = note {
+        // A RuntimeWarning, shown once per call site like any warning; the campaign goes on.
+        let text = std::ffi::CString::new(note).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<PyRuntimeWarning>(), &text, 2)?;
+    }
     let range = match shard {
         Some((k, n)) => montecarlo::shard_range(total_runs, k, n),
         None => 0..total_runs,

@@ -6,7 +6,7 @@ use crate::result::RunResult;
 use crate::run::{RunError, execute};
 use crate::{DICT_SOURCE_NAME, TEXT_SOURCE_NAME};
 use polhode::scenario::{self, Overrides};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
@@ -163,19 +163,28 @@ impl PyScenario {
         &self,
         py: Python<'_>,
         method: Option<String>,
-        dt: Option<f64>,
-        rtol: Option<f64>,
-        atol: Option<f64>,
-        duration: Option<f64>,
+        dt: Option<Bound<'_, PyAny>>,
+        rtol: Option<Bound<'_, PyAny>>,
+        atol: Option<Bound<'_, PyAny>>,
+        duration: Option<Bound<'_, PyAny>>,
         log: Option<PathBuf>,
     ) -> PyResult<RunResult> {
+        // Checked before the run starts, not after it has been integrated.
+        if let Some(p) = &log
+            && p.as_os_str().is_empty()
+        {
+            return Err(PyValueError::new_err(
+                "log: expected the path of the MCAP file to write, got an empty string (leave \
+                 `log` out to write no log)",
+            ));
+        }
         let write_log = log.is_some();
         let overrides = Overrides {
             method,
-            dt,
-            rtol,
-            atol,
-            duration,
+            dt: real("dt", dt)?,
+            rtol: real("rtol", rtol)?,
+            atol: real("atol", atol)?,
+            duration: real("duration", duration)?,
             mcap: log,
             ..Overrides::default()
         };
@@ -197,10 +206,31 @@ impl PyScenario {
                 return Err(PyValueError::new_err(m));
             }
             Ok(Err(RunError::Io(m))) => return Err(PyOSError::new_err(m)),
+            Ok(Err(RunError::Memory(m))) => return Err(PyMemoryError::new_err(m)),
             Err(panic) => {
                 return Err(internal_error("running the scenario", panic.as_ref()));
             }
         };
         RunResult::new(py, products)
     }
+}
+
+/// An optional real-valued keyword argument: a float or an int, not a bool (`True` is an int
+/// to Python, but `duration=True` is a mistake, as `from_dict` already says).
+fn real(name: &str, value: Option<Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+    let Some(v) = value else { return Ok(None) };
+    if v.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "{name}: expected a number, got the boolean {}",
+            if v.is_truthy()? { "True" } else { "False" }
+        )));
+    }
+    v.extract::<f64>().map(Some).map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{name}: expected a number, got {}",
+            v.get_type()
+                .name()
+                .map_or_else(|_| "another type".to_string(), |n| n.to_string())
+        ))
+    })
 }

@@ -24,21 +24,22 @@ pub(crate) const MAX_RESERVED_SAMPLES: usize = 1 << 21;
 
 impl ColumnStore {
     /// Room for `samples` samples (at most [`MAX_RESERVED_SAMPLES`]); the zeroed buffer is
-    /// committed by the OS page by page as samples arrive.
-    fn new(width: usize, samples: usize) -> Self {
+    /// committed by the OS page by page as samples arrive. `Err` when it cannot be allocated.
+    fn new(width: usize, samples: usize) -> Result<Self, String> {
         let cap = samples.clamp(1, MAX_RESERVED_SAMPLES);
-        ColumnStore {
+        Ok(ColumnStore {
             width,
             cap,
             len: 0,
-            data: vec![0.0; width * cap],
-        }
+            data: zeroed(width * cap)?,
+        })
     }
 
-    fn push(&mut self, row: &[f64]) {
+    fn push(&mut self, row: &[f64]) -> std::io::Result<()> {
         if self.len == self.cap {
             let cap = self.cap * 2;
-            let mut data = vec![0.0; self.width * cap];
+            let mut data = zeroed(self.width * cap)
+                .map_err(|m| std::io::Error::new(std::io::ErrorKind::OutOfMemory, m))?;
             for k in 0..self.width {
                 data[k * cap..k * cap + self.len]
                     .copy_from_slice(&self.data[k * self.cap..k * self.cap + self.len]);
@@ -50,6 +51,7 @@ impl ColumnStore {
             self.data[k * self.cap + self.len] = *v;
         }
         self.len += 1;
+        Ok(())
     }
 
     /// The filled columns back to back (`width * len` values), the buffer shrunk to fit.
@@ -66,6 +68,15 @@ impl ColumnStore {
     }
 }
 
+/// `n` zeros, or the allocation failure as a message (`try_reserve`: never an abort).
+fn zeroed(n: usize) -> Result<Vec<f64>, String> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|e| polhode::resources::reserve_failed("the run's samples", n, &e))?;
+    v.resize(n, 0.0);
+    Ok(v)
+}
+
 /// Keeps every output sample's telemetry and effector fields (the columns of
 /// `polhode run --csv`) and forwards everything to the MCAP log when there is one.
 pub(crate) struct Collector<'a> {
@@ -80,7 +91,7 @@ pub(crate) struct Collector<'a> {
 impl Sink for Collector<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()> {
         samples::fill_row(&mut self.row, self.spacecraft, o, y, inv);
-        self.store.push(&self.row);
+        self.store.push(&self.row)?;
         match self.log.as_mut() {
             Some(log) => log.sample(o, y, inv),
             None => Ok(()),
@@ -124,6 +135,8 @@ pub(crate) enum RunError {
     Refused(String),
     /// The log could not be created, written or finished.
     Io(String),
+    /// The samples would not fit in the memory limit, or could not be allocated.
+    Memory(String),
 }
 
 /// Validates with `overrides` and runs, on the worker thread (no Python here).
@@ -145,6 +158,18 @@ pub(crate) fn execute(
             .check()
             .map_err(RunError::Refused)?;
     }
+    let names: Vec<String> = samples::columns(&s.spacecraft)
+        .into_iter()
+        .map(|c| c.name)
+        .collect();
+    // Known before anything is allocated or integrated: refused with the numbers.
+    polhode::resources::check_sample_memory(
+        &format!("{}: the run's samples", s.path.display()),
+        s.duration,
+        s.output_rate,
+        names.len(),
+    )
+    .map_err(RunError::Memory)?;
     let logger = if log {
         let mut logger = McapLogger::create(&s.mcap_path, &s, s.omega0.norm()).map_err(|e| {
             RunError::Io(format!(
@@ -167,15 +192,20 @@ pub(crate) fn execute(
     } else {
         None
     };
-    let names: Vec<String> = samples::columns(&s.spacecraft)
-        .into_iter()
-        .map(|c| c.name)
-        .collect();
     // Samples at k / rate up to the end, and the last instant.
-    let expected = (s.duration * s.output_rate).floor().max(0.0) as usize + 2;
+    let expected = polhode::resources::sample_count(s.duration, s.output_rate) as usize;
+    let store = match ColumnStore::new(names.len(), expected) {
+        Ok(store) => store,
+        Err(m) => {
+            if let Some(l) = logger {
+                l.abandon();
+            }
+            return Err(RunError::Memory(m));
+        }
+    };
     let mut collector = Collector {
         spacecraft: &s.spacecraft,
-        store: ColumnStore::new(names.len(), expected),
+        store,
         row: Vec::with_capacity(names.len()),
         log: logger,
     };
@@ -188,6 +218,9 @@ pub(crate) fn execute(
         Err(e) => {
             if let Some(l) = collector.log.take() {
                 l.abandon();
+            }
+            if e.kind() == std::io::ErrorKind::OutOfMemory {
+                return Err(RunError::Memory(e.to_string()));
             }
             return Err(RunError::Io(format!(
                 "writing the log failed: {e}; no log was kept"

@@ -72,6 +72,21 @@ pub(super) fn compare_cmd(
         eprintln!("error: {e}");
         return EXIT_BAD_INPUT;
     }
+    // Every row keeps its (t, nutation) series until the chart is drawn: two values a sample,
+    // bounded by the longest row's.
+    if let Some(s) = scenarios
+        .iter()
+        .max_by(|a, b| (a.duration * a.output_rate).total_cmp(&(b.duration * b.output_rate)))
+        && let Err(e) = crate::resources::check_sample_memory(
+            &format!("{}: the compared runs' series", s.path.display()),
+            s.duration,
+            s.output_rate,
+            2 * scenarios.len(),
+        )
+    {
+        eprintln!("error: {e}");
+        return EXIT_BAD_INPUT;
+    }
     let columns = crate::compare::Columns::new(&scenarios, &option_events);
     let interrupt = Arc::new(AtomicBool::new(false));
     {

@@ -73,13 +73,18 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         );
         return EXIT_BAD_INPUT;
     }
-    if threads == Some(0) {
-        eprintln!("error: --threads: expected at least 1");
-        return EXIT_BAD_INPUT;
-    }
-    let threads = threads.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
+    let threads = match montecarlo::thread_count(threads, "--threads") {
+        Ok((t, note)) => {
+            if let Some(note) = note {
+                eprintln!("warning: {note}");
+            }
+            t
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     let range = match shard {
         Some([k, n]) => montecarlo::shard_range(prep.campaign.runs, k, n),
         None => 0..prep.campaign.runs,

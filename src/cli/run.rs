@@ -158,7 +158,32 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
     let outcome = match result {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("error: writing the log failed: {e}; no log was kept");
+            // Name what was being written: the log, the tables, or both.
+            let tables: Vec<String> = outputs
+                .csv
+                .into_iter()
+                .chain(outputs.parquet)
+                .map(|p| p.display().to_string())
+                .collect();
+            let (what, kept) = match (logger.is_some(), tables.is_empty()) {
+                (true, true) => (
+                    format!("the log {}", s.mcap_path.display()),
+                    "no log was kept",
+                ),
+                (false, _) => (
+                    format!("the sampled telemetry {}", tables.join(" / ")),
+                    "no table was kept",
+                ),
+                (true, false) => (
+                    format!(
+                        "the log {} or the sampled telemetry {}",
+                        s.mcap_path.display(),
+                        tables.join(" / ")
+                    ),
+                    "no log was kept, nor any table",
+                ),
+            };
+            eprintln!("error: writing {what} failed: {e}; {kept}");
             if let Some(l) = logger {
                 l.abandon();
             }

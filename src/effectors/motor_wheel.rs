@@ -233,6 +233,15 @@ impl Effector for MotorWheel {
             _ => {}
         }
     }
+    fn sampled_rate_loop(&self) -> Option<(nalgebra::Matrix3<f64>, f64)> {
+        match &self.mode {
+            // The reaction on the hub of the command u = gains·ω along the axis.
+            MotorMode::RateDamping(law) => {
+                Some((self.axis * law.gains.transpose(), law.clock.period))
+            }
+            _ => None,
+        }
+    }
     fn held_rotor_states(&self) -> Option<Vec<(usize, f64)>> {
         // At the held rate the motor supplies the friction: K_i z = f(Ω_cmd) (with K_i = 0
         // a proportional loop settles off its command, so no state holds the rate exactly).

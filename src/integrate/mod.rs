@@ -158,18 +158,35 @@ pub(crate) struct StepEnd {
     pub underflow: bool,
 }
 
+/// A step no longer than this many units of `f64::EPSILON` relative to `|t|` is below the
+/// resolution of `t`: an adaptive method reports a step-size underflow.
+pub const UNDERFLOW_EPS: f64 = 16.0;
+
+/// Two instants closer than this many units of `f64::EPSILON` relative to the larger are one
+/// instant for the integration: four times [`UNDERFLOW_EPS`], so that no stop is ever asked for
+/// that a step could not reach without underflowing.
+pub const SAME_INSTANT_EPS: f64 = 4.0 * UNDERFLOW_EPS;
+
+/// Whether `a` and `b` (s) are the same instant for the integration: within a few ulps
+/// ([`SAME_INSTANT_EPS`]) of each other, as a controller tick k·Δt and the duration m/f can be.
+/// A breakpoint within that distance of the end, or of another breakpoint, is merged with it.
+pub fn same_instant(a: f64, b: f64) -> bool {
+    (b - a).abs() <= SAME_INSTANT_EPS * f64::EPSILON * a.abs().max(b.abs())
+}
+
 /// Where an adaptive step of size `h_wanted` (s) from `t` ends: exactly on `t_end` when it
-/// would reach within 1e-12 of the remaining span (no sliver of a step is left), else at
+/// would reach within 1e-12 of the remaining span, or within a few ulps of `t_end`
+/// ([`same_instant`]) (no sliver of a step is left that could not be taken), else at
 /// `t + h_wanted`.
 pub(crate) fn adaptive_step_end(t: f64, h_wanted: f64, t_end: f64) -> StepEnd {
-    let last = h_wanted >= (t_end - t) * (1.0 - 1e-12);
+    let last = h_wanted >= (t_end - t) * (1.0 - 1e-12) || same_instant(t + h_wanted, t_end);
     let t_new = if last { t_end } else { t + h_wanted };
     let h = t_new - t;
     StepEnd {
         t_new,
         h,
         last,
-        underflow: h.abs() <= 16.0 * f64::EPSILON * t.abs().max(1e-300),
+        underflow: h.abs() <= UNDERFLOW_EPS * f64::EPSILON * t.abs().max(1e-300),
     }
 }
 

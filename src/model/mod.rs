@@ -280,6 +280,12 @@ pub trait Effector: Any + Debug + Send + Sync {
     /// controller samples the hub state here (its tick) and holds its command. Also called
     /// once at t = 0 by [`Spacecraft::initial_state`]: a controller's first tick.
     fn at_breakpoint(&self, _hub: &HubState, _x: &mut [f64]) {}
+    /// For its share of a discrete linear loop on the body rate (hub torque −G ω sampled
+    /// every `period` s and held): its gain matrix G (N m s, body axes) and `period`. Read by
+    /// the failure diagnosis, which blames a sampled loop whose G·Δt overcorrects the inertia.
+    fn sampled_rate_loop(&self) -> Option<(nalgebra::Matrix3<f64>, f64)> {
+        None
+    }
     /// For a rotor whose motor holds its relative rate: the states (index within this
     /// effector, value) that make the held rate an equilibrium, the rate first. `None` for
     /// anything else.

@@ -44,6 +44,45 @@ pub const BLOCK_RUNS: u64 = 4096;
 /// (see `Prepared::longest_first`).
 pub const ORDERED_RUNS_PER_THREAD: usize = 32;
 
+/// Worker threads allowed per logical core: a campaign asking for more threads than
+/// [`max_threads`] gets that many. Threads beyond the cores only add contention (rayon's own
+/// default is one per logical core), and a pool of 10⁵ threads takes minutes to start, during
+/// which nothing answers Ctrl-C or SIGTERM.
+pub const THREADS_PER_CORE: usize = 4;
+
+/// The logical cores of this machine (1 when unknown).
+pub fn logical_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
+}
+
+/// The most worker threads a campaign uses: [`THREADS_PER_CORE`] × the logical cores.
+pub fn max_threads() -> usize {
+    THREADS_PER_CORE * logical_cores()
+}
+
+/// The worker threads for a requested count (`None`: one per logical core), with a note when
+/// the request was above [`max_threads`] and was capped; `what` names the option in messages
+/// (`--threads`, `threads`). `Err` for 0.
+pub fn thread_count(
+    requested: Option<usize>,
+    what: &str,
+) -> Result<(usize, Option<String>), String> {
+    let cap = max_threads();
+    match requested {
+        None => Ok((logical_cores(), None)),
+        Some(0) => Err(format!("{what}: expected at least 1, got 0")),
+        Some(t) if t > cap => Ok((
+            cap,
+            Some(format!(
+                "{what} {t}: capped at {cap} ({THREADS_PER_CORE} × {} logical cores); more \
+                 threads than cores only add contention",
+                logical_cores()
+            )),
+        )),
+        Some(t) => Ok((t, None)),
+    }
+}
+
 /// A run as [`Prepared::build_run`] builds it.
 type Built = Result<(Scenario, Vec<f64>), InvalidDraw>;
 
@@ -125,12 +164,46 @@ impl Prepared {
         const QUOTE: &str = "a text value in this scenario reads as a number (e.g. `name: 1e2`, \
                              `name: 0x1F`, `name: .nan`); quote it (`name: \"1e2\"`) to run a \
                              campaign";
-        let mut tree: Value = serde_saphyr::from_str(&scenario.source).map_err(|e| {
-            let first = e.without_snippet().to_string();
-            let first = first.lines().next().unwrap_or("").to_string();
-            let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
-            ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
-        })?;
+        let mut tree: Value =
+            serde_saphyr::from_str_with_options(&scenario.source, crate::scenario::yaml_options())
+                .map_err(|e| {
+                    let first = e.without_snippet().to_string();
+                    let first = first.lines().next().unwrap_or("").to_string();
+                    let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+                    // A number that is not finite (`.nan`, `.inf`) where a number is expected
+                    // (`probability_by: [.nan]`) is that, not text reading as a number.
+                    let line = location.and_then(|(l, _)| {
+                        crate::scenario::yaml_line(&scenario.source, l).map(|t| (l, t))
+                    });
+                    if let Some((l, text)) = line {
+                        let lower = text.to_ascii_lowercase();
+                        let key = lower
+                            .split(':')
+                            .next()
+                            .unwrap_or("")
+                            .trim()
+                            .trim_start_matches("- ");
+                        if key != "name"
+                            && let Some(k) = [".nan", ".inf", "-.inf", "+.inf"]
+                                .iter()
+                                .filter_map(|w| lower.find(w))
+                                .min()
+                        {
+                            let column = text[..k].chars().count() as u32 + 1;
+                            let word: String = text[k..]
+                                .chars()
+                                .take_while(|c| !matches!(c, ',' | ']' | '}' | ' '))
+                                .collect();
+                            return ScenarioError::at(
+                                &path,
+                                Some((l, column)),
+                                crate::scenario::field_path_at(&scenario.source, l, column),
+                                format!("expected a finite number, got `{word}`"),
+                            );
+                        }
+                    }
+                    ScenarioError::at(&path, location, "", format!("{QUOTE} ({first})"))
+                })?;
         if let Some(map) = tree.as_object_mut() {
             map.remove("montecarlo");
         }
@@ -495,7 +568,7 @@ impl Prepared {
         consume: &mut dyn FnMut(Row) -> Result<(), String>,
     ) -> Result<bool, String> {
         let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.max(1))
+            .num_threads(threads.clamp(1, max_threads()))
             .build()
             .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
         let mut partial = false;

@@ -59,6 +59,10 @@ pub struct KeplerSolution {
     pub sin_e: f64,
     /// `cos E`.
     pub cos_e: f64,
+    /// `1 − cos E`, to full relative precision also where `cos E` rounds to 1 (small `E`):
+    /// `2 sin²(E/2)` of the reduced `E`. With it `cos E − e = (1 − e) − (1 − cos E)` and
+    /// `1 − e cos E = (1 − e) + e(1 − cos E)` keep their digits as `e → 1`.
+    pub one_minus_cos_e: f64,
     /// Halley (or bisection) iterations taken (0 for `e = 0`, `M = 0` or `|M| = π`).
     pub iterations: u32,
 }
@@ -82,10 +86,12 @@ pub fn solve(mean_anomaly: f64, e: f64) -> KeplerSolution {
         (1.0, m_red)
     };
     let (e_red, sin_e, cos_e, iterations) = solve_reduced(m, e);
+    let half_sin = (0.5 * e_red).sin();
     KeplerSolution {
         eccentric_anomaly: sign * e_red + k * TAU,
         sin_e: sign * sin_e,
         cos_e,
+        one_minus_cos_e: 2.0 * half_sin * half_sin,
         iterations,
     }
 }

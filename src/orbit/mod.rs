@@ -13,7 +13,9 @@
 //!   Students*, ch. 3–4): `M = M₀ + Ṁ t`, Kepler's equation `E − e sin E = M` ([`kepler`]),
 //!   perifocal position `a(cos E − e) P̂ + a√(1−e²) sin E Q̂`, velocity
 //!   `(√(μa)/r)(−sin E P̂ + √(1−e²) cos E Q̂)`, `r = a(1 − e cos E)`, with the perifocal axes
-//!   `[P̂ Q̂ Ŵ] = R3(−Ω) R1(−i) R3(−ω)`.
+//!   `[P̂ Q̂ Ŵ] = R3(−Ω) R1(−i) R3(−ω)`. `cos E − e` and `1 − e cos E` are formed as
+//!   `(1 − e) − (1 − cos E)` and `(1 − e) + e(1 − cos E)` with `1 − cos E = 2 sin²(E/2)`,
+//!   which keep their digits as `e → 1` near perigee, where `cos E` rounds to 1.
 //! - Optional secular J2 drift ([`Orbit::new`] with `j2_secular`): Ω, ω and M advance at
 //!   the first-order secular rates (Vallado §9.6), and the state is formed from the
 //!   drifted elements as in Vallado's PKEPLER algorithm (§9.6). The velocity is then the
@@ -125,6 +127,9 @@ pub struct Orbit {
 struct Phase {
     sin_e: f64,
     cos_e: f64,
+    /// `cos E − e`, as `(1 − e) − (1 − cos E)`: no cancellation as `e → 1` near perigee,
+    /// where `cos E` and `e` both round to about 1 and their difference to noise.
+    cos_e_minus_e: f64,
     /// Orbit radius (m).
     r: f64,
     /// Perifocal axes P̂, Q̂, Ŵ in ECI.
@@ -230,12 +235,13 @@ impl Orbit {
     fn phase(&self, t: f64) -> Phase {
         let e = self.elements.eccentricity;
         let m = self.mean_anomaly(t);
-        let (sin_e, cos_e) = if e == 0.0 {
+        let (sin_e, cos_e, one_minus_cos_e) = if e == 0.0 {
             // Circular: E = M, no Kepler solve; the table-driven sin/cos (a few ulps).
-            crate::sincos::sin_cos(m)
+            let (s, c) = crate::sincos::sin_cos(m);
+            (s, c, 1.0 - c)
         } else {
             let s = kepler::solve(m, e);
-            (s.sin_e, s.cos_e)
+            (s.sin_e, s.cos_e, s.one_minus_cos_e)
         };
         let axes = if self.j2_secular {
             perifocal_axes(self.raan(t), self.cos_i, self.sin_i, self.arg_perigee(t))
@@ -245,7 +251,16 @@ impl Orbit {
         Phase {
             sin_e,
             cos_e,
-            r: self.elements.semi_major_axis * (1.0 - e * cos_e),
+            cos_e_minus_e: if e == 0.0 {
+                cos_e
+            } else {
+                (1.0 - e) - one_minus_cos_e
+            },
+            r: if e == 0.0 {
+                self.elements.semi_major_axis
+            } else {
+                self.elements.semi_major_axis * ((1.0 - e) + e * one_minus_cos_e)
+            },
             axes,
         }
     }
@@ -253,9 +268,9 @@ impl Orbit {
     /// Position (m) and velocity (m/s) in ECI at time t (s since the epoch).
     pub fn state(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let ph = self.phase(t);
-        let (a, e) = (self.elements.semi_major_axis, self.elements.eccentricity);
+        let a = self.elements.semi_major_axis;
         let [p, q, _] = ph.axes;
-        let r = p * (a * (ph.cos_e - e)) + q * (self.b * ph.sin_e);
+        let r = p * (a * ph.cos_e_minus_e) + q * (self.b * ph.sin_e);
         let k = self.sqrt_mu_a / ph.r;
         let v = p * (-k * ph.sin_e) + q * (k * self.eta * ph.cos_e);
         (r, v)
@@ -279,7 +294,7 @@ impl Orbit {
             // Circular: r = a, and the position is a (P̂ cos E + Q̂ sin E) exactly.
             return (p * ph.cos_e + q * ph.sin_e, a);
         }
-        let r = p * (a * (ph.cos_e - e)) + q * (self.b * ph.sin_e);
+        let r = p * (a * ph.cos_e_minus_e) + q * (self.b * ph.sin_e);
         (r / ph.r, ph.r)
     }
 
@@ -310,7 +325,7 @@ impl Orbit {
     /// True anomaly ν (rad, in `(−π, π]`).
     pub fn true_anomaly(&self, t: f64) -> f64 {
         let ph = self.phase(t);
-        (self.eta * ph.sin_e).atan2(ph.cos_e - self.elements.eccentricity)
+        (self.eta * ph.sin_e).atan2(ph.cos_e_minus_e)
     }
 
     /// Argument of latitude `u = ω + ν` (rad, in `[0, 2π)`): the angle from the ascending
@@ -326,7 +341,7 @@ impl Orbit {
         let [p, q, w] = ph.axes;
         // Normalised by the length of the perifocal position itself (not by r from
         // a(1 − e cos E)), so that cos²ν + sin²ν = 1 to rounding for any e.
-        let (x, y) = (a * (ph.cos_e - e), self.b * ph.sin_e);
+        let (x, y) = (a * ph.cos_e_minus_e, self.b * ph.sin_e);
         let rho = (x * x + y * y).sqrt();
         let (cos_nu, sin_nu) = (x / rho, y / rho);
         let r_hat = p * cos_nu + q * sin_nu;

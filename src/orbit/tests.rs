@@ -67,8 +67,13 @@ fn kepler_residual_and_bisection_agreement() {
                 eccentric_anomaly: ea,
                 sin_e,
                 cos_e,
+                one_minus_cos_e,
                 iterations,
             } = kepler::solve(m, e);
+            assert!(
+                (one_minus_cos_e - (1.0 - cos_e)).abs() <= 4.0 * f64::EPSILON,
+                "e = {e}, M = {m}: 1 − cos E {one_minus_cos_e:e}, cos E {cos_e}"
+            );
             let res = (ea - e * ea.sin() - m).abs();
             let bound = 4.0 * f64::EPSILON * m.abs().max(1.0);
             assert!(

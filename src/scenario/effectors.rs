@@ -420,14 +420,9 @@ impl Check<'_> {
         }
     }
     fn unit(&self, s: &Spanned<[f64; 3]>, key: &str) -> Result<Vector3<f64>, ScenarioError> {
-        let v = Vector3::from(s.value);
-        // Scale first, so that huge or tiny components neither overflow nor underflow.
-        let m = v.amax();
-        if v.iter().all(|x| x.is_finite()) && m > 0.0 {
-            Ok((v / m).normalize())
-        } else {
-            Err(self.err(s, key, "expected a non-zero vector of three finite numbers"))
-        }
+        // Scaled first, so that huge or tiny components neither overflow nor underflow.
+        super::unit_vector(&Vector3::from(s.value))
+            .ok_or_else(|| self.err(s, key, "expected a non-zero vector of three finite numbers"))
     }
     fn perpendicular(
         &self,
@@ -663,18 +658,20 @@ pub(super) fn build(
             EffectorSpec::SolarPressure(sp) => {
                 let orbit = &needs_orbit()?;
                 let area = ck.positive(&sp.area, "area", "m²")?;
-                let n = Vector3::from(sp.normal.value);
-                if !n.iter().all(|c| c.is_finite()) || n.norm() < MIN_POSITIVE {
+                let Some(n) = super::unit_vector(&Vector3::from(sp.normal.value)) else {
+                    let num = crate::timefmt::number;
                     return Err(ck.err(
                         &sp.normal,
                         "normal",
                         format!(
                             "expected a non-zero vector of three finite numbers (body axes), \
                              got [{}, {}, {}]",
-                            sp.normal.value[0], sp.normal.value[1], sp.normal.value[2]
+                            num(sp.normal.value[0]),
+                            num(sp.normal.value[1]),
+                            num(sp.normal.value[2])
                         ),
                     ));
-                }
+                };
                 let r_cp = Vector3::from(sp.center_of_pressure.value);
                 if !r_cp.iter().all(|c| c.is_finite()) || r_cp.norm() > MAX_PRESSURE_ARM {
                     return Err(ck.err(
@@ -734,7 +731,7 @@ pub(super) fn build(
                     orbit: orbit.clone(),
                     epoch_unix_ns: cx.epoch_unix_ns,
                     area,
-                    normal: n.normalize(),
+                    normal: n,
                     center_of_pressure: r_cp + cx.shift,
                     specular: rho[0],
                     diffuse: rho[1],

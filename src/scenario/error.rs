@@ -32,7 +32,7 @@ impl ScenarioError {
             line: location.map(|l| l.0),
             column: location.map(|l| l.1),
             field: (!field.is_empty()).then_some(field),
-            message: message.into(),
+            message: crate::timefmt::tidy(&message.into()),
         }
     }
 

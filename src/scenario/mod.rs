@@ -6,6 +6,7 @@
 //! [`Scenario`] ready to run.
 
 mod body;
+mod bounds;
 pub mod campaign;
 mod effectors;
 mod error;
@@ -427,22 +428,39 @@ pub fn load(path: &Path, overrides: &Overrides) -> Result<Scenario, ScenarioErro
     parse(path, source, overrides)
 }
 
+/// Line `line` (1-based) of `source`, as YAML counts lines.
+pub fn yaml_line(source: &str, line: u32) -> Option<&str> {
+    error::yaml_lines(source)
+        .get(line.checked_sub(1)? as usize)
+        .copied()
+}
+
+/// How scenario text is read: YAML 1.2 core booleans only (`true`/`false`), so that `yes`,
+/// `on`, `'y'` or `'off'` are strings, as YAML 1.2 says, and a boolean key refuses them.
+pub fn yaml_options() -> serde_saphyr::Options {
+    serde_saphyr::options! { strict_booleans: true }
+}
+
 /// Parses and validates scenario text (`path` is used in messages and for nothing else).
 pub fn parse(
     path: &Path,
     source: String,
     overrides: &Overrides,
 ) -> Result<Scenario, ScenarioError> {
-    let file: ScenarioFile = match serde_saphyr::from_str(&source) {
+    let file: ScenarioFile = match serde_saphyr::from_str_with_options(&source, yaml_options()) {
         Ok(f) => f,
         Err(e) => return Err(yaml_error(path, &source, &e)),
     };
-    file.validate(path, source, overrides)
+    // Plausible physical bounds on every number, after the field checks (whose messages
+    // say more about the fields they know).
+    let bounded = bounds::check(path, &source);
+    let scenario = file.validate(path, source, overrides)?;
+    bounded.map(|()| scenario)
 }
 
 /// Turns a YAML-layer error into a located [`ScenarioError`] with a suggestion for misspelt keys.
 fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioError {
-    let location = e.location().map(|l| (l.line() as u32, l.column() as u32));
+    let mut location = e.location().map(|l| (l.line() as u32, l.column() as u32));
     let rendered = e.without_snippet().to_string();
     let mut message = rendered.lines().next().unwrap_or("").trim().to_string();
     // Drop the library's own "error: line L column C:" prefix; we print the location ourselves.
@@ -590,6 +608,41 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
         && let Some(n) = expected.split_whitespace().last()
     {
         message = format!("expected a list of {n} values, got {got}");
+    } else if message.starts_with("invalid boolean") {
+        message = format!(
+            "expected `true` or `false`{found} (YAML 1.2: yes, no, on, off, y and n are text, \
+             not booleans)"
+        );
+    } else if let Some(kind) = message
+        .strip_prefix("invalid ")
+        .filter(|k| matches!(*k, "u8" | "u16" | "u32" | "u64" | "usize"))
+    {
+        let max = match kind {
+            "u8" => "255",
+            "u16" => "65535",
+            "u32" => "4294967295",
+            _ => "18446744073709551615",
+        };
+        // The parser may point past a flow mapping's end: name the count it could not read.
+        let bad = location.and_then(|(l, c)| not_a_count_before(source, l, c));
+        let got = match &bad {
+            Some((_, _, text, _)) => format!(", got `{text}`"),
+            None => found.clone(),
+        };
+        if let Some((l, c, _, inline)) = bad {
+            location = Some((l, c));
+            // The block keys down to this line, then the inline keys to the value.
+            let block = field_path_at(source, l, 1);
+            field = field_path_at(source, l, c);
+            if !field.ends_with(&inline) {
+                field = if block.is_empty() {
+                    inline
+                } else {
+                    format!("{block}.{inline}")
+                };
+            }
+        }
+        message = format!("expected a whole number from 0 to {max}{got}");
     } else if let Some(rest) = message.strip_prefix("duplicate mapping key: ") {
         let key = rest.split(',').next().unwrap_or(rest).trim();
         message = format!("`{key}` is given twice; a key may appear once in a mapping");
@@ -621,6 +674,61 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
         message = format!("{message}: this key is required");
     }
     ScenarioError::at(path, location, field, message)
+}
+
+/// The `key: value` on `line` whose value is a number but not a whole number from 0 up (a
+/// count of -1 or 2.5): the first at or after `column` (the parser points at the start of
+/// the flow mapping that holds it), else the last before. Its (line, column), text and the
+/// inline keys that lead to it (`wheel.copies.count`).
+fn not_a_count_before(source: &str, line: u32, column: u32) -> Option<(u32, u32, String, String)> {
+    let text = *error::yaml_lines(source).get(line.checked_sub(1)? as usize)?;
+    let chars: Vec<char> = text.chars().collect();
+    let mut best = None;
+    // Keys whose values are the open `{…}` mappings, and the key just read.
+    let mut open: Vec<String> = Vec::new();
+    let mut key_start = 0;
+    for k in 0..chars.len() {
+        match chars[k] {
+            '{' => {
+                let before: String = chars[key_start..k].iter().collect();
+                let key = before.trim().trim_end_matches(':').trim().to_string();
+                open.push(key);
+                key_start = k + 1;
+            }
+            '}' => {
+                open.pop();
+                key_start = k + 1;
+            }
+            ',' | '[' | ']' => key_start = k + 1,
+            ':' => {
+                let key: String = chars[key_start..k].iter().collect();
+                let key = key.trim().trim_start_matches("- ").to_string();
+                let mut s = k + 1;
+                while s < chars.len() && chars[s] == ' ' {
+                    s += 1;
+                }
+                let mut e = s;
+                while e < chars.len() && !matches!(chars[e], ',' | '}' | ']' | ' ' | '#') {
+                    e += 1;
+                }
+                let value: String = chars[s..e].iter().collect();
+                if value.parse::<f64>().is_ok() && value.parse::<u64>().is_err() {
+                    let mut path: Vec<&str> = open
+                        .iter()
+                        .map(String::as_str)
+                        .filter(|k| !k.is_empty() && *k != "-")
+                        .collect();
+                    path.push(&key);
+                    best = Some((line, s as u32 + 1, value, path.join(".")));
+                    if s + 1 >= column as usize {
+                        break;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    best
 }
 
 /// Where a bracket or quote opened before `line` (1-based) is still open, for syntax errors
@@ -675,6 +783,14 @@ fn scalar_at(source: &str, line: u32, column: u32) -> Option<String> {
 
 pub(crate) fn loc<T>(s: &Spanned<T>) -> Option<(u32, u32)> {
     Some((s.referenced.line() as u32, s.referenced.column() as u32))
+}
+
+/// `v` over its length, or `None` for a zero or non-finite vector. Scaled by its largest
+/// component first, so that [1e200, 1e200, 0] does not overflow to an infinite length and
+/// [1e-300, 1e-300, 0] does not underflow to a zero one.
+pub fn unit_vector(v: &Vector3<f64>) -> Option<Vector3<f64>> {
+    let m = v.amax();
+    (v.iter().all(|x| x.is_finite()) && m > 0.0).then(|| (v / m).normalize())
 }
 
 fn finite3(v: &[f64; 3]) -> bool {
@@ -768,6 +884,39 @@ pub(crate) fn key_location(source: &str, key: &str) -> Option<(u32, u32)> {
         .map(|i| (i as u32 + 1, 1))
 }
 
+/// The (line, column) of the value of the `n`-th (0-based) `name:` key whose value is `name`
+/// (plain or quoted), in block or inline style.
+fn nth_name_location(source: &str, name: &str, n: usize) -> Option<(u32, u32)> {
+    let mut seen = 0;
+    for (i, line) in error::yaml_lines(source).into_iter().enumerate() {
+        let mut from = 0;
+        while let Some(k) = line[from..].find("name:") {
+            let key = from + k;
+            from = key + 5;
+            if key > 0 && line[..key].ends_with(|c: char| c.is_alphanumeric() || c == '_') {
+                continue;
+            }
+            let rest = &line[from..];
+            let value = rest.trim_start();
+            let text = value
+                .split([',', '}', '#'])
+                .next()
+                .unwrap_or("")
+                .trim()
+                .trim_matches(['"', '\'']);
+            if text == name {
+                if seen == n {
+                    let byte = from + (rest.len() - value.len());
+                    let column = line[..byte].chars().count() as u32 + 1;
+                    return Some((i as u32 + 1, column));
+                }
+                seen += 1;
+            }
+        }
+    }
+    None
+}
+
 fn loc_of<T>(s: &Option<Spanned<T>>) -> Option<(u32, u32)> {
     s.as_ref().and_then(loc)
 }
@@ -831,15 +980,14 @@ impl ScenarioFile {
         // Spin axis: given, or the principal axis closest to the initial angular momentum.
         let spin_axis = match &self.body.spin_axis {
             Some(s) => {
-                let v = Vector3::from(s.value);
-                if !finite3(&s.value) || v.norm() == 0.0 {
+                let Some(v) = unit_vector(&Vector3::from(s.value)) else {
                     return Err(err(
                         loc(s),
                         "body.spin_axis",
                         "expected a non-zero vector of three finite numbers (body axes)".into(),
                     ));
-                }
-                v.normalize()
+                };
+                v
             }
             None => default_spin_axis(&hub, &omega0),
         };
@@ -1006,12 +1154,26 @@ impl ScenarioFile {
         let mut spacecraft = Spacecraft::new(hub, spin_axis);
         spacecraft.hub_mass = hub_mass;
         for e in built {
+            let name = e.name().to_string();
+            let duplicate = spacecraft.effectors().iter().any(|x| x.name() == name);
             spacecraft.add_effector(e).map_err(|e| {
-                err(
-                    self.body.mass.as_ref().and_then(loc),
-                    "body.mass",
-                    e.to_string(),
-                )
+                // A repeated name is an error of the second `name:` that spells it (a name a
+                // `copies:` block made is reported at the effectors list); anything else is
+                // about the hub's mass.
+                if duplicate {
+                    let at = nth_name_location(&source, &name, 1)
+                        .or_else(|| key_location(&source, "effectors"));
+                    let field = at
+                        .map(|(l, c)| error::field_path_at(&source, l, c))
+                        .unwrap_or_else(|| "effectors".into());
+                    err(at, &field, e.to_string())
+                } else {
+                    err(
+                        self.body.mass.as_ref().and_then(loc),
+                        "body.mass",
+                        e.to_string(),
+                    )
+                }
             })?;
         }
         if let Some(m) = &self.hub_motion {
@@ -1318,16 +1480,17 @@ pub fn parse_condition(text: &str) -> Result<Condition, String> {
     if text.trim().is_empty() {
         return Err(EXPECTED.into());
     }
-    let spec: Spanned<ConditionSpec> = serde_saphyr::from_str(text).map_err(|e| {
-        let err = yaml_error(path, text, &e);
-        if err.message.starts_with("the document is not a mapping")
-            || err.message.starts_with("the file is empty")
-        {
-            EXPECTED.to_string()
-        } else {
-            render(err)
-        }
-    })?;
+    let spec: Spanned<ConditionSpec> = serde_saphyr::from_str_with_options(text, yaml_options())
+        .map_err(|e| {
+            let err = yaml_error(path, text, &e);
+            if err.message.starts_with("the document is not a mapping")
+                || err.message.starts_with("the file is empty")
+            {
+                EXPECTED.to_string()
+            } else {
+                render(err)
+            }
+        })?;
     let mut list = conditions(path, "event", std::slice::from_ref(&spec)).map_err(render)?;
     Ok(list.remove(0))
 }
@@ -1417,10 +1580,9 @@ fn shape(path: &Path, s: &Spanned<ShapeSpec>) -> Result<Shape, ScenarioError> {
             if !positive(*radius) || !positive(*length) {
                 return Err(bad("expected a positive radius and length (m)"));
             }
-            let axis = Vector3::from(axis.unwrap_or([0.0, 0.0, 1.0]));
-            if !axis.iter().all(|x| x.is_finite()) || axis.norm() == 0.0 {
+            let Some(axis) = unit_vector(&Vector3::from(axis.unwrap_or([0.0, 0.0, 1.0]))) else {
                 return Err(bad("expected a non-zero cylinder axis"));
-            }
+            };
             let orientation = UnitQuaternion::rotation_between(&Vector3::z(), &axis)
                 .unwrap_or_else(|| {
                     UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI)

@@ -86,6 +86,20 @@ pub(super) fn orbit(
             ));
         }
     }
+    // The inclination is checked here, where its own location is known (Elements::validate
+    // only has the number).
+    if let Some(inc) = &spec.inclination_deg
+        && !(0.0..=180.0).contains(&inc.value)
+    {
+        return Err(at(
+            loc(inc),
+            "inclination_deg",
+            format!(
+                "expected an inclination from 0 to 180 degrees, got {}",
+                crate::timefmt::number(inc.value)
+            ),
+        ));
+    }
     let angle = |v: &Option<Spanned<f64>>| v.as_ref().map_or(0.0, |a| a.value.to_radians());
     let (i, raan, argp, nu) = (
         angle(&spec.inclination_deg),

@@ -365,10 +365,25 @@ const COLLAPSE_WINDOW: u64 = 10_000;
 /// Where the next step must end at the latest: the run's end, or the first breakpoint of an
 /// effector after `t` (a commanded torque's step), where the right-hand side jumps and the
 /// integrator stops exactly and restarts ([`Stepper::restart`]).
+///
+/// Breakpoints a few ulps apart (a tick k·Δt and a step time m/f that are the same instant in
+/// exact arithmetic) are one stop, at the latest of them, where every effector takes its new
+/// value; a breakpoint within a few ulps of the end is the end
+/// ([`crate::integrate::same_instant`]). Otherwise the step between them would be below the
+/// resolution of t and an adaptive method would fail with a step-size underflow.
 fn next_stop(sc: &crate::model::Spacecraft, t: f64, t_end: f64) -> f64 {
-    match sc.next_breakpoint(t) {
-        Some(b) if b < t_end => b,
-        _ => t_end,
+    let Some(mut b) = sc.next_breakpoint(t) else {
+        return t_end;
+    };
+    while let Some(next) = sc.next_breakpoint(b)
+        && crate::integrate::same_instant(b, next)
+    {
+        b = next;
+    }
+    if b >= t_end || crate::integrate::same_instant(b, t_end) {
+        t_end
+    } else {
+        b
     }
 }
 
@@ -877,6 +892,8 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
     let m = &sim.method;
     let (cause, remedy) = if let Some(found) = model_outside_range(sc, y) {
         found
+    } else if let Some(found) = unstable_sampled_loop(sc) {
+        found
     } else {
         match (m.fixed_step(), stability_bound(m)) {
             (Some(h), Some(bound)) if rho.is_finite() && h * rho > 0.8 * bound => (
@@ -925,11 +942,53 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
             ),
         }
     };
-    format!(
+    crate::timefmt::tidy(&format!(
         "{what}; state at t = {} [ω (rad/s), q (w,x,y,z)] = [{state}]; suspected cause: \
          {cause}; suggested remedy: {remedy}",
         seconds(t)
-    )
+    ))
+}
+
+/// A discrete rate loop that overcorrects: with the hub torque −G ω sampled every Δt and
+/// held, the rate about an axis of moment I goes as ω_{k+1} = (1 − g Δt / I) ω_k, which
+/// diverges when g Δt / I > 2 (g the loop's gain about that axis). Checked with the largest
+/// gain against the smallest principal moment, the worst case. The cause and the remedy.
+fn unstable_sampled_loop(sc: &Spacecraft) -> Option<(String, String)> {
+    let mut gain = nalgebra::Matrix3::zeros();
+    let mut period: f64 = 0.0;
+    for e in sc.effectors() {
+        if let Some((g, dt)) = e.sampled_rate_loop() {
+            gain += g;
+            period = period.max(dt);
+        }
+    }
+    if period <= 0.0 {
+        return None;
+    }
+    let sym = (gain + gain.transpose()) * 0.5;
+    let k = sym.symmetric_eigenvalues().amax();
+    let inertia = sc.hub.principal_moments.min();
+    let ratio = k * period / inertia;
+    if ratio.is_nan() || ratio <= 2.0 {
+        return None;
+    }
+    let n = crate::timefmt::number;
+    Some((
+        format!(
+            "the discrete rate-damping loop is unstable: gain {} N m s sampled every {} s \
+             against a moment of inertia of {} kg m² gives gain × interval / inertia = {} > 2, \
+             so each tick overcorrects the rate and the oscillation grows",
+            crate::timefmt::approx(k),
+            n(period),
+            n(inertia),
+            crate::timefmt::approx(ratio)
+        ),
+        format!(
+            "lower the gain below {} N m s, or raise sample_rate above {} Hz",
+            crate::timefmt::approx(2.0 * inertia / period),
+            crate::timefmt::approx(k / (2.0 * inertia))
+        ),
+    ))
 }
 
 fn keep_event(events: &mut Vec<EventRecord>, not_kept: &mut u64, e: EventRecord) {
