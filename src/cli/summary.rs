@@ -266,6 +266,13 @@ pub(super) fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
             "  {energy}: |H| {:.3e}  H_N {:.3e}  {label} {:.3e}  |q| {:.3e}",
             o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
         );
+    } else if s.spacecraft.keeps_momentum_norm() {
+        // The torques turn H but keep |H| (an energy sink): a change of |H| is drift.
+        println!(
+            "  {energy}: |H| {:.3e}; change (torque that turns H): H_N {:.3e}; {energy}: \
+             {label} {:.3e}  |q| {:.3e}",
+            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm
+        );
     } else if s.spacecraft.conserves_energy() {
         println!(
             "  change (external torque): |H| {:.3e}  H_N {:.3e}; {energy}: {label} {:.3e}  \

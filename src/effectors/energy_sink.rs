@@ -65,6 +65,10 @@ impl Effector for EnergySink {
     fn needs_rigid_spacecraft(&self) -> bool {
         true
     }
+    fn keeps_momentum_norm(&self) -> bool {
+        // H·τ = 0.
+        true
+    }
     fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
         -self.coefficient * self.transverse_rate(&hub.omega)
     }

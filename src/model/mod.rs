@@ -262,6 +262,11 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn is_external(&self) -> bool {
         false
     }
+    /// Whether its external torque is always perpendicular to H, so that it turns H without
+    /// changing |H| (the energy sink). Only an effector with [`Effector::is_external`] asks.
+    fn keeps_momentum_norm(&self) -> bool {
+        false
+    }
     /// Whether its model takes the spacecraft to be otherwise rigid (the quasi-rigid energy
     /// sink, whose Ĥ is the hub's Iω): then no effector that carries momentum of its own
     /// (one that is not [`Effector::torque_only`]) may share the spacecraft, whichever is
@@ -694,6 +699,16 @@ impl Spacecraft {
     /// motion): then its drift is a measure of integration error.
     pub fn conserves_momentum(&self) -> bool {
         self.motion.is_none() && !self.effectors.iter().any(|e| e.is_external())
+    }
+
+    /// Whether |H| is kept although H is not: every external torque is perpendicular to H
+    /// (the energy sink's), so a change of |H| is drift, not the torque's work.
+    pub fn keeps_momentum_norm(&self) -> bool {
+        self.motion.is_none()
+            && self
+                .effectors
+                .iter()
+                .all(|e| !e.is_external() || e.keeps_momentum_norm())
     }
 
     /// Whether kinetic + elastic + dissipated energy is conserved (no prescribed motion).
