@@ -25,7 +25,7 @@ root=$(pwd)
 fuzz_dir="$root/fuzz"
 
 CARGO_FUZZ_VERSION=0.13.2
-TARGETS=(scenario_loader writers)
+TARGETS=(scenario_loader writers method_pairs)
 
 seconds=${1:-30}
 if ! [[ $seconds =~ ^[0-9]+$ ]] || ((seconds < 1)); then
@@ -87,11 +87,18 @@ bin_dir="$fuzz_dir/target/$host/release"
 
 # Seeds: the shipped scenarios for the loader; a few random inputs of several sizes for the
 # structured writers target (any bytes make a valid input; they give it long inputs to start).
-mkdir -p "$fuzz_dir/corpus/scenario_loader" "$fuzz_dir/corpus/writers"
+mkdir -p "$fuzz_dir/corpus/scenario_loader" "$fuzz_dir/corpus/writers" "$fuzz_dir/corpus/method_pairs"
 cp "$root"/scenarios/*.yaml "$root"/tests/data/*.yaml "$fuzz_dir/corpus/scenario_loader/"
 for size in 256 1024 4096 8192; do
     for k in 1 2 3; do
         seed="$fuzz_dir/corpus/writers/seed-$size-$k"
+        [[ -e $seed ]] || head -c "$size" /dev/urandom >"$seed"
+    done
+done
+# method_pairs builds its scenario from structured input: any bytes make one.
+for size in 32 64 128 256; do
+    for k in 1 2 3; do
+        seed="$fuzz_dir/corpus/method_pairs/seed-$size-$k"
         [[ -e $seed ]] || head -c "$size" /dev/urandom >"$seed"
     done
 done
