@@ -252,6 +252,15 @@ fn merge_refuses_bad_shard_sets() {
     m["run_range"] = serde_json::json!([9, 3]);
     std::fs::write(other_build.join("campaign.json"), m.to_string()).unwrap();
     refused(&[&s1, &s2, &other_build], "impossible run range");
+    // Columns of the same count that differ: the first one that differs, by name.
+    m = serde_json::from_str(&manifest).unwrap();
+    let second = m["columns"][1].as_str().unwrap().to_string();
+    m["columns"][1] = "renamed".into();
+    std::fs::write(other_build.join("campaign.json"), m.to_string()).unwrap();
+    refused(
+        &[&s1, &s2, &other_build],
+        &format!("table column 2 `renamed` differs from `{second}`"),
+    );
 
     // Not a campaign output at all.
     refused(

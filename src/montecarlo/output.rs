@@ -1083,11 +1083,18 @@ pub fn check_shards(dirs: &[PathBuf]) -> Result<ShardSet, String> {
             return Err(mismatch("run count", &m.runs, &m0.runs));
         }
         if m.columns != m0.columns {
-            return Err(mismatch(
-                "table columns",
-                &m.columns.len(),
-                &m0.columns.len(),
-            ));
+            // Name what differs: the count, or the first column that is not the same.
+            let (a, b) = match m.columns.iter().zip(&m0.columns).position(|(a, b)| a != b) {
+                Some(k) if m.columns.len() == m0.columns.len() => (
+                    format!("column {} `{}`", k + 1, m.columns[k]),
+                    format!("`{}`", m0.columns[k]),
+                ),
+                _ => (
+                    format!("{} columns", m.columns.len()),
+                    format!("{}", m0.columns.len()),
+                ),
+            };
+            return Err(mismatch("table", &a, &b));
         }
         match m.shard {
             Some([_, n2]) if n2 == n => {}
