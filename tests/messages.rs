@@ -85,6 +85,23 @@ fn cases() -> Vec<(&'static str, String, &'static str, &'static str)> {
             "",
         ),
         (
+            "omega-ten-values",
+            BASE.replace("[0.1, 0.0, 1.0]", "[1, 2, 3, 4, 5, 6, 7, 8, 9, 10]"),
+            "initial.omega",
+            "expected a list of 3 values, got more than 3",
+        ),
+        (
+            // 85 000 table rows are 255 000 YAML nodes, past the reader's 250 000.
+            "too-many-nodes",
+            format!(
+                "{BASE}effectors:\n  - wheel:\n      axial_inertia: 0.01\n      axis: [0,0,1]\n      \
+                 motor: {{torque: {{steps: [{}]}}}}\n",
+                vec!["[1,0]"; 85_000].join(",")
+            ),
+            "",
+            "past the reader's limit",
+        ),
+        (
             "assembly-law",
             format!(
                 "{BASE}effectors:\n  - wheel:\n      name: a\n      axial_inertia: 0.01\n      \
@@ -299,5 +316,47 @@ fn a_nan_in_probability_by_is_called_not_finite() {
         err.contains("field `montecarlo.probability_by`: expected a finite number, got `.nan`"),
         "{err}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A name `check` accepts is one `montecarlo` can write its directory under: the longest
+/// name of multi-byte characters gives a campaign directory within the file-name limit.
+#[test]
+fn check_and_montecarlo_agree_on_a_long_name() {
+    let dir = scratch("long-name");
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/cubesat-detumble.yaml"),
+    )
+    .unwrap();
+    let long = "é".repeat(200);
+    let yaml: String = source
+        .lines()
+        .map(|l| {
+            if l.starts_with("name:") {
+                format!("name: {long}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let file = dir.join("long.yaml");
+    std::fs::write(&file, yaml).unwrap();
+    let (code, err) = check(&file);
+    assert_eq!(code, Some(0), "{err}");
+    let out = polhode()
+        .current_dir(&dir)
+        .args(["montecarlo", "--runs", "2"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let campaign = std::fs::read_dir(dir.join("logs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.join("runs.csv").exists())
+        .expect("a campaign directory with runs.csv");
+    assert!(campaign.file_name().unwrap().len() <= 255);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -458,6 +458,28 @@ pub fn parse(
     bounded.map(|()| scenario)
 }
 
+/// What a breach of the YAML reader's resource limits means, in the scenario's terms.
+fn budget_message(breach: &serde_saphyr::budget::BudgetBreach) -> String {
+    use serde_saphyr::budget::BudgetBreach as B;
+    let limit = match breach {
+        B::Nodes { nodes } => format!("more than {} values, lists and mappings", nodes - 1),
+        B::Events { events } => format!("more than {} YAML events", events - 1),
+        B::Depth { depth } => format!("nesting {depth} levels deep"),
+        B::Aliases { aliases } => format!("{aliases} aliases (`*name`)"),
+        B::Anchors { anchors } => format!("{anchors} anchors (`&name`)"),
+        B::Documents { documents } => format!("{documents} documents"),
+        B::MergeKeys { merge_keys } => format!("{merge_keys} merge keys (`<<`)"),
+        B::AliasAnchorRatio { aliases, anchors } => {
+            format!("{aliases} aliases of {anchors} anchors (an alias expansion bomb?)")
+        }
+        _ => "more text than a scenario needs".into(),
+    };
+    format!(
+        "the YAML holds {limit}, past the reader's limit; a scenario's lists and tables are \
+         short (a torque table of a few hundred points is plenty)"
+    )
+}
+
 /// Turns a YAML-layer error into a located [`ScenarioError`] with a suggestion for misspelt keys.
 fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioError {
     let mut location = e.location().map(|l| (l.line() as u32, l.column() as u32));
@@ -480,6 +502,9 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
     }
     if message.is_empty() {
         message = "invalid YAML".into();
+    }
+    if let serde_saphyr::Error::Budget { breach, .. } = e.without_snippet() {
+        return ScenarioError::at(path, location, "", budget_message(breach));
     }
     const TOP_LEVEL: &str = "expected a mapping of scenario keys (`name`, `body`, `initial`, \
                              `duration`, ...)";
@@ -607,6 +632,12 @@ fn yaml_error(path: &Path, source: &str, e: &serde_saphyr::Error) -> ScenarioErr
         && let Some((got, expected)) = rest.split_once(", expected ")
         && let Some(n) = expected.split_whitespace().last()
     {
+        // The reader stops at the first value past the expected count, so `got` is then
+        // n + 1 whatever the list's real length.
+        let got = match (got.parse::<usize>(), n.parse::<usize>()) {
+            (Ok(g), Ok(m)) if g == m + 1 => format!("more than {m}"),
+            _ => got.to_string(),
+        };
         message = format!("expected a list of {n} values, got {got}");
     } else if message.starts_with("invalid boolean") {
         message = format!(
