@@ -5,6 +5,7 @@
 //! - [`SpringMass`]: a particle on a line with spring and dashpot.
 //! - [`WheelDamper`]: a viscous wheel damper about a body axis.
 //! - [`HingedRod`]: a rigid rod on a hinge with one or two rotational degrees of freedom.
+//! - [`SloshPendulum`]: a damped spherical pendulum, the analog of a tank's lateral slosh.
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
@@ -14,7 +15,7 @@
 //! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure,
 //!   and [`aerodynamic::ShapeAerodynamic`] on the facets of the body's shape.
 //!
-//! The three mass-moving ones share the particle formulation of [`particles`]; each effector
+//! The mass-moving ones share the particle formulation of [`particles`]; each effector
 //! adds only its own states.
 
 pub mod aerodynamic;
@@ -34,6 +35,7 @@ pub mod motor_wheel;
 pub mod particles;
 pub mod rayleigh;
 pub mod rod_lanes;
+pub mod slosh_pendulum;
 pub mod solar_pressure;
 pub mod spring_mass;
 pub mod wheel;
@@ -49,6 +51,7 @@ pub use motion::SpinUp;
 pub use motor_wheel::MotorWheel;
 pub use particles::{ParticleEffector, ParticleModel};
 pub use rayleigh::Rayleigh;
+pub use slosh_pendulum::SloshPendulum;
 pub use solar_pressure::SolarPressure;
 pub use spring_mass::SpringMass;
 pub use wheel::WheelDamper;

@@ -211,7 +211,10 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
     let fixed = |d: &'static str, u: &'static str| Some((Cow::Borrowed(d), u));
     match (kind, field) {
         (_, "sim_time") => return fixed("Simulation time since the epoch", "s"),
-        ("spring_mass_damper" | "hinged_rod" | "modal_appendage", "elastic_energy") => {
+        (
+            "spring_mass_damper" | "hinged_rod" | "modal_appendage" | "slosh_pendulum",
+            "elastic_energy",
+        ) => {
             return fixed("Elastic energy stored in this effector", "J");
         }
         (_, "dissipated_energy") => {
@@ -236,6 +239,20 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("hinged_rod", "tip_x") => return fixed("Rod tip position, body x", "m"),
         ("hinged_rod", "tip_y") => return fixed("Rod tip position, body y", "m"),
         ("hinged_rod", "tip_z") => return fixed("Rod tip position, body z", "m"),
+        ("slosh_pendulum", "phi") => {
+            return fixed(
+                "Pendulum angle phi, the rod turned about p3 from its rest direction",
+                "rad",
+            );
+        }
+        ("slosh_pendulum", "theta") => {
+            return fixed("Pendulum angle theta, the rod tipped toward -p3", "rad");
+        }
+        ("slosh_pendulum", "phi_rate") => return fixed("Rate of phi", "rad/s"),
+        ("slosh_pendulum", "theta_rate") => return fixed("Rate of theta", "rad/s"),
+        ("slosh_pendulum", "swing_deg") => {
+            return fixed("Angle between the rod and its rest direction", "deg");
+        }
         ("modal_appendage", "tip_flap") => {
             return fixed("Tip deflection along the flap direction", "m");
         }

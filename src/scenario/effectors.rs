@@ -16,9 +16,11 @@ use serde_saphyr::Spanned;
 use std::path::Path;
 
 mod magnetorquer;
+mod slosh_pendulum;
 mod wheel;
 
 use magnetorquer::MagnetorquerSpec;
+use slosh_pendulum::SloshPendulumSpec;
 use wheel::MotorWheelSpec;
 
 /// One entry of `effectors:`.
@@ -37,6 +39,8 @@ pub enum EffectorSpec {
     Wheel(Box<MotorWheelSpec>),
     /// Rigid rod on a hinge.
     HingedRod(HingedRodSpec),
+    /// Damped spherical pendulum (the slosh analog).
+    SloshPendulum(SloshPendulumSpec),
     /// Modal cantilever beam.
     ModalAppendage(ModalSpec),
     /// Gravity-gradient torque of the central body (needs `orbit:`).
@@ -571,6 +575,7 @@ pub(super) fn build(
             EffectorSpec::WheelDamper(_) => "wheel_damper",
             EffectorSpec::Wheel(_) => "wheel",
             EffectorSpec::HingedRod(_) => "hinged_rod",
+            EffectorSpec::SloshPendulum(_) => "slosh_pendulum",
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
@@ -939,6 +944,14 @@ pub(super) fn build(
                     &[q0],
                     &[u0],
                 )));
+            }
+            EffectorSpec::SloshPendulum(s) => {
+                out.push(Box::new(slosh_pendulum::build(
+                    &ck,
+                    cx,
+                    s,
+                    name_of(&s.name),
+                )?));
             }
             EffectorSpec::Wheel(w) => {
                 wheel::build(
