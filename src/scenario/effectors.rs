@@ -6,20 +6,23 @@
 use super::{MAX_MAGNITUDE, MIN_POSITIVE, ScenarioError, Shape, loc};
 use crate::effectors::beam::{BeamProperties, beam_modes};
 use crate::effectors::{
-    EnergySink, HingeFreedom, HingedRod, ModalBeam, ParticleEffector, Rayleigh, SpinUp, SpringMass,
-    WheelDamper,
+    HingeFreedom, HingedRod, ModalBeam, ParticleEffector, SpinUp, SpringMass, WheelDamper,
 };
 use crate::model::{Effector, RigidBody};
-use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::Path;
 
+mod energy_sink;
 mod magnetorquer;
+mod rayleigh;
 mod slosh_pendulum;
 mod wheel;
 
+use energy_sink::EnergySinkSpec;
 use magnetorquer::MagnetorquerSpec;
+use rayleigh::RayleighSpec;
 use slosh_pendulum::SloshPendulumSpec;
 use wheel::MotorWheelSpec;
 
@@ -142,37 +145,6 @@ pub struct GravityGradientSpec {
     /// Name (default `gravity_gradient`).
     #[serde(default)]
     pub name: Option<String>,
-}
-
-/// `rayleigh:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RayleighSpec {
-    /// Name (default `rayleigh`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Γ as a full symmetric matrix (N m s/rad, body axes, rows).
-    #[serde(default)]
-    pub gamma: Option<Spanned<[[f64; 3]; 3]>>,
-    /// Γ as a diagonal (N m s/rad), instead of `gamma`.
-    #[serde(default)]
-    pub gamma_diagonal: Option<Spanned<[f64; 3]>>,
-}
-
-/// `energy_sink:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EnergySinkSpec {
-    /// Name (default `energy_sink`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Coefficient c (N m s/rad).
-    #[serde(default)]
-    pub coefficient: Option<Spanned<f64>>,
-    /// Target nutation time constant (s), instead of `coefficient`: c is solved so that the
-    /// linearised nutation mode about the initial spin grows or decays as e^{±t/τ}.
-    #[serde(default)]
-    pub time_constant: Option<Spanned<f64>>,
 }
 
 /// `spring_mass_damper:`.
@@ -867,60 +839,22 @@ pub(super) fn build(
                 }
             }
             EffectorSpec::Rayleigh(r) => {
-                let gamma = match (&r.gamma, &r.gamma_diagonal) {
-                    (Some(g), None) => {
-                        let m = Matrix3::from_row_slice(&g.value.concat());
-                        check_psd(&ck, g, "gamma", &m)?;
-                        m
-                    }
-                    (None, Some(d)) => {
-                        let m = Matrix3::from_diagonal(&Vector3::from(d.value));
-                        check_psd(&ck, d, "gamma_diagonal", &m)?;
-                        m
-                    }
-                    _ => {
-                        return Err(ScenarioError::at(
-                            cx.path,
-                            item,
-                            ck.prefix.clone(),
-                            "expected exactly one of `gamma: [[..],[..],[..]]` or \
-                             `gamma_diagonal: [g1, g2, g3]` (N m s/rad)",
-                        ));
-                    }
-                };
-                out.push(Box::new(Rayleigh {
-                    name: name_of(&r.name),
-                    gamma,
-                }));
+                out.push(Box::new(rayleigh::build(
+                    &ck,
+                    cx,
+                    r,
+                    name_of(&r.name),
+                    item,
+                )?));
             }
             EffectorSpec::EnergySink(e) => {
-                let coefficient = match (&e.coefficient, &e.time_constant) {
-                    (Some(c), None) => ck.positive(c, "coefficient", "N m s/rad")?,
-                    (None, Some(t)) => {
-                        let tau = ck.positive(t, "time_constant", "s")?;
-                        crate::linearize::energy_sink_coefficient(
-                            cx.hub,
-                            cx.spin_axis,
-                            cx.omega0.dot(&cx.spin_axis),
-                            tau,
-                        )
-                        .map_err(|m| ck.err(t, "time_constant", m))?
-                    }
-                    _ => {
-                        return Err(ScenarioError::at(
-                            cx.path,
-                            item,
-                            ck.prefix.clone(),
-                            "expected exactly one of `coefficient` (N m s/rad) or \
-                             `time_constant` (s)",
-                        ));
-                    }
-                };
-                out.push(Box::new(EnergySink {
-                    name: name_of(&e.name),
-                    coefficient,
-                    inertia: cx.hub.inertia,
-                }));
+                out.push(Box::new(energy_sink::build(
+                    &ck,
+                    cx,
+                    e,
+                    name_of(&e.name),
+                    item,
+                )?));
             }
             EffectorSpec::SpringMassDamper(s) => {
                 let model = SpringMass {
@@ -1243,34 +1177,6 @@ fn copy_name(base: &str, k: usize, count: usize) -> String {
     } else {
         base.to_string()
     }
-}
-
-fn check_psd<T>(
-    ck: &Check,
-    s: &Spanned<T>,
-    key: &str,
-    m: &Matrix3<f64>,
-) -> Result<(), ScenarioError> {
-    if !m.iter().all(|x| x.is_finite()) {
-        return Err(ck.err(s, key, "expected finite numbers (N m s/rad)"));
-    }
-    let scale = m.amax().max(f64::MIN_POSITIVE);
-    if (m - m.transpose()).amax() > 1e-12 * scale {
-        return Err(ck.err(s, key, "expected a symmetric matrix"));
-    }
-    let eig = m.symmetric_eigenvalues();
-    if eig.min() < -1e-12 * scale {
-        return Err(ck.err(
-            s,
-            key,
-            format!(
-                "expected a positive semi-definite matrix (a dissipation function cannot be \
-                 negative); its smallest eigenvalue is {:e}",
-                eig.min()
-            ),
-        ));
-    }
-    Ok(())
 }
 
 /// Validates `hub_motion:`.
