@@ -5,9 +5,7 @@
 
 use super::{MAX_MAGNITUDE, MIN_POSITIVE, ScenarioError, Shape, loc};
 use crate::effectors::beam::{BeamProperties, beam_modes};
-use crate::effectors::{
-    HingeFreedom, HingedRod, ModalBeam, ParticleEffector, SpinUp, SpringMass, WheelDamper,
-};
+use crate::effectors::{HingeFreedom, HingedRod, ModalBeam, ParticleEffector, SpinUp};
 use crate::model::{Effector, RigidBody};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
@@ -18,13 +16,17 @@ mod energy_sink;
 mod magnetorquer;
 mod rayleigh;
 mod slosh_pendulum;
+mod spring_mass_damper;
 mod wheel;
+mod wheel_damper;
 
 use energy_sink::EnergySinkSpec;
 use magnetorquer::MagnetorquerSpec;
 use rayleigh::RayleighSpec;
 use slosh_pendulum::SloshPendulumSpec;
+use spring_mass_damper::SpringMassSpec;
 use wheel::MotorWheelSpec;
+use wheel_damper::WheelSpec;
 
 /// One entry of `effectors:`.
 #[derive(Debug, Deserialize)]
@@ -145,59 +147,6 @@ pub struct GravityGradientSpec {
     /// Name (default `gravity_gradient`).
     #[serde(default)]
     pub name: Option<String>,
-}
-
-/// `spring_mass_damper:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SpringMassSpec {
-    /// Name (default `spring_mass_damper`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Particle mass (kg).
-    pub mass: Spanned<f64>,
-    /// Point of the line at zero offset (m, body axes, about the hub's centre of mass, or the
-    /// whole spacecraft's with `body.composite`).
-    pub position: Spanned<[f64; 3]>,
-    /// Direction of the line (body axes).
-    pub direction: Spanned<[f64; 3]>,
-    /// Spring stiffness (N/m).
-    pub stiffness: Spanned<f64>,
-    /// Dashpot coefficient (N s/m).
-    pub damping: Spanned<f64>,
-    /// Initial offset (m).
-    #[serde(default)]
-    pub initial_offset: Option<Spanned<f64>>,
-    /// Initial rate (m/s).
-    #[serde(default)]
-    pub initial_rate: Option<Spanned<f64>>,
-    /// Travel |offset| the damper's stops allow (m); beyond it the model does not hold.
-    #[serde(default)]
-    pub travel: Option<Spanned<f64>>,
-}
-
-/// `wheel_damper:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct WheelSpec {
-    /// Name (default `wheel_damper`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Rotor axial inertia (kg m²), included in `body` as if locked.
-    pub inertia: Spanned<f64>,
-    /// Rotor axis (body axes).
-    pub axis: Spanned<[f64; 3]>,
-    /// Viscous coefficient (N m s/rad).
-    pub damping: Spanned<f64>,
-    /// Initial rotor rate relative to the body (rad/s).
-    #[serde(default)]
-    pub initial_rate: Option<Spanned<f64>>,
-    /// Where to draw it (m, body axes).
-    #[serde(default)]
-    pub position: Option<Spanned<[f64; 3]>>,
-    /// Largest relative rotor speed the wheel is rated for (rad/s).
-    #[serde(default)]
-    pub max_speed: Option<Spanned<f64>>,
 }
 
 /// A scalar applied to both hinge angles, or `[flap, lag]`.
@@ -857,27 +806,12 @@ pub(super) fn build(
                 )?));
             }
             EffectorSpec::SpringMassDamper(s) => {
-                let model = SpringMass {
-                    mass: ck.positive(&s.mass, "mass", "kg")?,
-                    position: ck.on_body(&s.position, "position", "the line's point", cx)?
-                        + cx.shift,
-                    direction: ck.unit(&s.direction, "direction")?,
-                    stiffness: ck.non_negative(&s.stiffness, "stiffness", "N/m")?,
-                    damping: ck.non_negative(&s.damping, "damping", "N s/m")?,
-                    travel: s
-                        .travel
-                        .as_ref()
-                        .map(|t| ck.positive(t, "travel", "m"))
-                        .transpose()?,
-                };
-                let q0 = ck.finite(&s.initial_offset, "initial_offset", "m")?;
-                let u0 = ck.finite(&s.initial_rate, "initial_rate", "m/s")?;
-                out.push(Box::new(ParticleEffector::new(
+                out.push(Box::new(spring_mass_damper::build(
+                    &ck,
+                    cx,
+                    s,
                     name_of(&s.name),
-                    model,
-                    &[q0],
-                    &[u0],
-                )));
+                )?));
             }
             EffectorSpec::SloshPendulum(s) => {
                 out.push(Box::new(slosh_pendulum::build(
@@ -899,38 +833,7 @@ pub(super) fn build(
                 )?;
             }
             EffectorSpec::WheelDamper(w) => {
-                out.push(Box::new(WheelDamper {
-                    name: name_of(&w.name),
-                    inertia: ck.positive(&w.inertia, "inertia", "kg m²")?,
-                    axis: ck.unit(&w.axis, "axis")?,
-                    damping: ck.non_negative(&w.damping, "damping", "N m s/rad")?,
-                    initial_rate: ck.finite(&w.initial_rate, "initial_rate", "rad/s")?,
-                    position: match &w.position {
-                        Some(p) => ck.point(p, "position")? + cx.shift,
-                        None => cx.shift,
-                    },
-                    max_speed: w
-                        .max_speed
-                        .as_ref()
-                        .map(|v| ck.positive(v, "max_speed", "rad/s"))
-                        .transpose()?,
-                }));
-                // The rotor is part of the body's inertia: I − I_W â âᵀ must stay positive
-                // definite, i.e. I_W âᵀ I⁻¹ â < 1 (stricter than I_W < âᵀ I â off the
-                // principal axes).
-                let a = ck.unit(&w.axis, "axis")?;
-                let limit = 1.0 / a.dot(&(cx.hub.inertia_inv * a));
-                if w.inertia.value >= limit {
-                    return Err(ck.err(
-                        &w.inertia,
-                        "inertia",
-                        format!(
-                            "the rotor's inertia must be less than 1 / (âᵀ I⁻¹ â) = {limit} kg m² \
-                             for this axis: the body's inertia includes the rotor, and the rest \
-                             of the body must keep a positive-definite inertia"
-                        ),
-                    ));
-                }
+                out.push(Box::new(wheel_damper::build(&ck, cx, w, name_of(&w.name))?));
             }
             EffectorSpec::HingedRod(h) => {
                 let freedom = match h.freedom.as_ref().map(|f| f.value.as_str()) {
