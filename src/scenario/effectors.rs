@@ -4,8 +4,7 @@
 //! Every physical parameter keeps its span, so an unphysical value is reported at its line.
 
 use super::{MAX_MAGNITUDE, MIN_POSITIVE, ScenarioError, Shape, loc};
-use crate::effectors::beam::{BeamProperties, beam_modes};
-use crate::effectors::{HingeFreedom, HingedRod, ModalBeam, ParticleEffector, SpinUp};
+use crate::effectors::SpinUp;
 use crate::model::{Effector, RigidBody};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
@@ -13,7 +12,9 @@ use serde_saphyr::Spanned;
 use std::path::Path;
 
 mod energy_sink;
+mod hinged_rod;
 mod magnetorquer;
+mod modal_appendage;
 mod rayleigh;
 mod slosh_pendulum;
 mod spring_mass_damper;
@@ -21,7 +22,9 @@ mod wheel;
 mod wheel_damper;
 
 use energy_sink::EnergySinkSpec;
+use hinged_rod::HingedRodSpec;
 use magnetorquer::MagnetorquerSpec;
+use modal_appendage::ModalSpec;
 use rayleigh::RayleighSpec;
 use slosh_pendulum::SloshPendulumSpec;
 use spring_mass_damper::SpringMassSpec;
@@ -149,25 +152,6 @@ pub struct GravityGradientSpec {
     pub name: Option<String>,
 }
 
-/// A scalar applied to both hinge angles, or `[flap, lag]`.
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
-pub enum PerAngle {
-    /// The same value for flap and lag.
-    Both(f64),
-    /// `[flap, lag]`.
-    Each([f64; 2]),
-}
-
-impl PerAngle {
-    fn pair(self) -> [f64; 2] {
-        match self {
-            PerAngle::Both(x) => [x, x],
-            PerAngle::Each(p) => p,
-        }
-    }
-}
-
 /// `copies: {count: 4, about: [0, 0, 1]}`: identical copies turned evenly about a body axis
 /// through the hub's centre of mass (e.g. turnstile antennas).
 #[derive(Debug, Deserialize)]
@@ -177,85 +161,6 @@ pub struct CopiesSpec {
     pub count: Spanned<u32>,
     /// Axis they are turned about (body axes).
     pub about: Spanned<[f64; 3]>,
-}
-
-/// `hinged_rod:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct HingedRodSpec {
-    /// Name (default `hinged_rod`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Rod mass (kg).
-    pub mass: Spanned<f64>,
-    /// Rod length (m).
-    pub length: Spanned<f64>,
-    /// Hinge point (m, body axes, about the hub's centre of mass, or the whole spacecraft's
-    /// with `body.composite`); checked to be on or in `body.shape` when one is given.
-    pub hinge: Spanned<[f64; 3]>,
-    /// Rest direction of the rod (body axes).
-    pub direction: Spanned<[f64; 3]>,
-    /// Hinge axis (⊥ direction): lag turns about it, flap tips toward it.
-    pub axis: Spanned<[f64; 3]>,
-    /// `flap_lag` (default), `flap` or `lag`.
-    #[serde(default)]
-    pub freedom: Option<Spanned<String>>,
-    /// Torsional stiffness (N m/rad), one value or `[flap, lag]`.
-    pub stiffness: Spanned<PerAngle>,
-    /// Torsional damping (N m s/rad), one value or `[flap, lag]`.
-    pub damping: Spanned<PerAngle>,
-    /// Initial `[flap, lag]` angles (rad).
-    #[serde(default)]
-    pub initial_angles: Option<Spanned<[f64; 2]>>,
-    /// Initial `[flap, lag]` rates (rad/s).
-    #[serde(default)]
-    pub initial_rates: Option<Spanned<[f64; 2]>>,
-    /// Copies turned about an axis.
-    #[serde(default)]
-    pub copies: Option<CopiesSpec>,
-}
-
-/// `modal_appendage:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ModalSpec {
-    /// Name (default `modal_appendage`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Beam length (m).
-    pub length: Spanned<f64>,
-    /// Bending stiffness EI (N m²).
-    pub bending_stiffness: Spanned<f64>,
-    /// Mass per unit length ρA (kg/m).
-    pub mass_per_length: Spanned<f64>,
-    /// Tip mass (kg).
-    #[serde(default)]
-    pub tip_mass: Option<Spanned<f64>>,
-    /// Root point (m, body axes, about the hub's centre of mass, or the whole spacecraft's
-    /// with `body.composite`); checked to be on or in `body.shape` when one is given.
-    pub attachment: Spanned<[f64; 3]>,
-    /// Beam direction (body axes).
-    pub direction: Spanned<[f64; 3]>,
-    /// First bending direction `flap` (⊥ direction); `lag` is direction × flap.
-    pub flap_direction: Spanned<[f64; 3]>,
-    /// `both` (default), `flap` or `lag`.
-    #[serde(default)]
-    pub bending: Option<Spanned<String>>,
-    /// Number of modes per bending direction (1–10, default 3).
-    #[serde(default)]
-    pub modes: Option<Spanned<u32>>,
-    /// Modal damping ratio ζ (default 0.005).
-    #[serde(default)]
-    pub damping_ratio: Option<Spanned<f64>>,
-    /// Model the foreshortening that stiffens a spun beam (default true).
-    #[serde(default)]
-    pub geometric_stiffening: Option<bool>,
-    /// Initial tip deflection along flap and lag (m), in the first mode's shape.
-    #[serde(default)]
-    pub initial_tip_deflection: Option<Spanned<[f64; 2]>>,
-    /// Copies turned about an axis.
-    #[serde(default)]
-    pub copies: Option<CopiesSpec>,
 }
 
 /// `hub_motion:`: a prescribed hub rotation.
@@ -836,159 +741,10 @@ pub(super) fn build(
                 out.push(Box::new(wheel_damper::build(&ck, cx, w, name_of(&w.name))?));
             }
             EffectorSpec::HingedRod(h) => {
-                let freedom = match h.freedom.as_ref().map(|f| f.value.as_str()) {
-                    None | Some("flap_lag") => HingeFreedom::FlapLag,
-                    Some("flap") => HingeFreedom::Flap,
-                    Some("lag") => HingeFreedom::Lag,
-                    Some(other) => {
-                        let f = h.freedom.as_ref().expect("present");
-                        return Err(ck.err(
-                            f,
-                            "freedom",
-                            format!("unknown freedom `{other}`, expected flap_lag, flap or lag"),
-                        ));
-                    }
-                };
-                let mass = ck.positive(&h.mass, "mass", "kg")?;
-                let length = ck.positive(&h.length, "length", "m")?;
-                let direction = ck.unit(&h.direction, "direction")?;
-                let axis = ck.perpendicular(&h.axis, "axis", &direction, "direction")?;
-                let hinge = ck.on_body(&h.hinge, "hinge", "the hinge", cx)?;
-                let pair = |s: &Spanned<PerAngle>, key: &str, unit: &str| {
-                    let p = s.value.pair();
-                    if p.iter().all(|x| (0.0..=MAX_MAGNITUDE).contains(x)) {
-                        Ok(p)
-                    } else {
-                        Err(ck.err(
-                            s,
-                            key,
-                            format!(
-                                "expected a value from 0 to {MAX_MAGNITUDE:e}, or [flap, lag] \
-                                 values from 0 to {MAX_MAGNITUDE:e} ({unit}), got {}",
-                                p.map(super::number).join(", ")
-                            ),
-                        ))
-                    }
-                };
-                let stiffness = pair(&h.stiffness, "stiffness", "N m/rad")?;
-                let damping = pair(&h.damping, "damping", "N m s/rad")?;
-                let finite2 = |s: &Option<Spanned<[f64; 2]>>, key: &str| match s {
-                    None => Ok([0.0; 2]),
-                    Some(v) if v.value.iter().all(|x| x.abs() <= MAX_MAGNITUDE) => Ok(v.value),
-                    Some(v) => Err(ck.err(v, key, "expected [flap, lag], two finite numbers")),
-                };
-                let a0 = finite2(&h.initial_angles, "initial_angles")?;
-                let r0 = finite2(&h.initial_rates, "initial_rates")?;
-                let (q0, u0): (Vec<f64>, Vec<f64>) = match freedom {
-                    HingeFreedom::FlapLag => (a0.to_vec(), r0.to_vec()),
-                    HingeFreedom::Flap => (vec![a0[0]], vec![r0[0]]),
-                    HingeFreedom::Lag => (vec![a0[1]], vec![r0[1]]),
-                };
-                let rotations = ck.copies(&h.copies)?;
-                check_copies_on_body(&ck, &h.copies, &rotations, &hinge, cx.shape)?;
-                let count = rotations.len();
-                for (k, rot) in rotations.into_iter().enumerate() {
-                    let rod = HingedRod {
-                        mass,
-                        length,
-                        hinge: rot * hinge + cx.shift,
-                        direction: rot * direction,
-                        axis: rot * axis,
-                        freedom,
-                        stiffness,
-                        damping,
-                    };
-                    let name = copy_name(&name_of(&h.name), k, count);
-                    out.push(Box::new(ParticleEffector::new(name, rod, &q0, &u0)));
-                }
+                hinged_rod::build(&ck, cx, h, name_of(&h.name), &mut out)?;
             }
             EffectorSpec::ModalAppendage(m) => {
-                let props = BeamProperties {
-                    length: ck.positive(&m.length, "length", "m")?,
-                    bending_stiffness: ck.positive(
-                        &m.bending_stiffness,
-                        "bending_stiffness",
-                        "N m²",
-                    )?,
-                    mass_per_length: ck.positive(&m.mass_per_length, "mass_per_length", "kg/m")?,
-                    tip_mass: match &m.tip_mass {
-                        Some(t) => ck.non_negative(t, "tip_mass", "kg")?,
-                        None => 0.0,
-                    },
-                };
-                let n_modes = match &m.modes {
-                    None => 3,
-                    Some(n) if (1..=10).contains(&n.value) => n.value as usize,
-                    Some(n) => return Err(ck.err(n, "modes", "expected 1 to 10 modes")),
-                };
-                let zeta = match &m.damping_ratio {
-                    None => 0.005,
-                    Some(z) => ck.non_negative(z, "damping_ratio", "–")?,
-                };
-                let direction = ck.unit(&m.direction, "direction")?;
-                let flap =
-                    ck.perpendicular(&m.flap_direction, "flap_direction", &direction, "direction")?;
-                let lag = direction.cross(&flap);
-                let attachment = ck.on_body(&m.attachment, "attachment", "the root", cx)?;
-                let which = match m.bending.as_ref().map(|b| b.value.as_str()) {
-                    None | Some("both") => vec![true, true],
-                    Some("flap") => vec![true, false],
-                    Some("lag") => vec![false, true],
-                    Some(other) => {
-                        let b = m.bending.as_ref().expect("present");
-                        return Err(ck.err(
-                            b,
-                            "bending",
-                            format!("unknown bending `{other}`, expected both, flap or lag"),
-                        ));
-                    }
-                };
-                let modes = beam_modes(&props, n_modes).map_err(|e| {
-                    ScenarioError::at(cx.path, loc(&m.length), ck.prefix.clone(), e)
-                })?;
-                let tip0 = match &m.initial_tip_deflection {
-                    None => [0.0; 2],
-                    Some(v) if v.value.iter().all(|x| x.is_finite()) => v.value,
-                    Some(v) => {
-                        return Err(ck.err(
-                            v,
-                            "initial_tip_deflection",
-                            "expected [flap, lag], two finite numbers (m)",
-                        ));
-                    }
-                };
-                let tip_phi = modes.nodes[modes.tip].phi[0];
-                let rotations = ck.copies(&m.copies)?;
-                check_copies_on_body(&ck, &m.copies, &rotations, &attachment, cx.shape)?;
-                let count = rotations.len();
-                for (k, rot) in rotations.into_iter().enumerate() {
-                    let mut bending = Vec::new();
-                    let mut q0 = Vec::new();
-                    for (d, (label, t)) in [("flap", flap), ("lag", lag)].into_iter().enumerate() {
-                        if which[d] {
-                            bending.push((label.to_string(), rot * t));
-                            let mut q = vec![0.0; n_modes];
-                            q[0] = tip0[d] / tip_phi;
-                            q0.extend(q);
-                        }
-                    }
-                    let n = q0.len();
-                    let beam = ModalBeam::new(
-                        modes.clone(),
-                        rot * attachment + cx.shift,
-                        rot * direction,
-                        bending,
-                        zeta,
-                        m.geometric_stiffening.unwrap_or(true),
-                    );
-                    let name = copy_name(&name_of(&m.name), k, count);
-                    out.push(Box::new(ParticleEffector::new(
-                        name,
-                        beam,
-                        &q0,
-                        &vec![0.0; n],
-                    )));
-                }
+                modal_appendage::build(&ck, cx, m, name_of(&m.name), &mut out)?;
             }
         }
     }
