@@ -12,7 +12,9 @@ use serde_saphyr::Spanned;
 use std::path::Path;
 
 mod energy_sink;
+mod gravity_gradient;
 mod hinged_rod;
+mod magnetic_dipole;
 mod magnetorquer;
 mod modal_appendage;
 mod rayleigh;
@@ -22,7 +24,9 @@ mod wheel;
 mod wheel_damper;
 
 use energy_sink::EnergySinkSpec;
+use gravity_gradient::GravityGradientSpec;
 use hinged_rod::HingedRodSpec;
+use magnetic_dipole::MagneticDipoleSpec;
 use magnetorquer::MagnetorquerSpec;
 use modal_appendage::ModalSpec;
 use rayleigh::RayleighSpec;
@@ -125,32 +129,6 @@ pub const MAX_PRESSURE_ARM: f64 = 1e3;
 pub const SOLAR_EPHEMERIS_END_UNIX_S: f64 = 2_524_608_000.0;
 /// 1950-01-01T00:00:00Z as Unix seconds: the start of the same span.
 pub const SOLAR_EPHEMERIS_START_UNIX_S: f64 = -631_152_000.0;
-
-/// `magnetic_dipole:` — a constant (residual) dipole moment on the hub in the first-degree
-/// IGRF field of the Earth.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MagneticDipoleSpec {
-    /// Name (default `magnetic_dipole`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// The dipole moment (A m², body axes).
-    pub moment: Spanned<[f64; 3]>,
-}
-
-/// Largest magnitude of a `magnetic_dipole` moment (A m²): far above any spacecraft's
-/// magnetorquers (tens to hundreds of A m²).
-pub const MAX_DIPOLE_MOMENT: f64 = 1e4;
-
-/// `gravity_gradient:` — no parameters beyond a name: the hub's inertia and the orbit give
-/// the torque.
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GravityGradientSpec {
-    /// Name (default `gravity_gradient`).
-    #[serde(default)]
-    pub name: Option<String>,
-}
 
 /// `copies: {count: 4, about: [0, 0, 1]}`: identical copies turned evenly about a body axis
 /// through the hub's centre of mass (e.g. turnstile antennas).
@@ -445,34 +423,23 @@ pub(super) fn build(
         };
         match spec {
             EffectorSpec::GravityGradient(g) => {
-                let orbit = &needs_orbit()?;
-                out.push(Box::new(crate::effectors::GravityGradient {
-                    name: name_of(&g.name),
-                    orbit: orbit.clone(),
-                    inertia: cx.hub.inertia,
-                }));
+                let orbit = needs_orbit()?;
+                out.push(Box::new(gravity_gradient::build(
+                    cx,
+                    name_of(&g.name),
+                    orbit,
+                )));
             }
             EffectorSpec::MagneticDipole(m) => {
-                let orbit = &needs_orbit()?;
-                let v = Vector3::from(m.moment.value);
-                if !v.iter().all(|c| c.is_finite()) || v.norm() > MAX_DIPOLE_MOMENT {
-                    return Err(ck.err(
-                        &m.moment,
-                        "moment",
-                        format!(
-                            "expected three finite numbers with magnitude at most \
-                             {MAX_DIPOLE_MOMENT:e} (A m², body axes), got [{}, {}, {}]",
-                            m.moment.value[0], m.moment.value[1], m.moment.value[2]
-                        ),
-                    ));
-                }
-                let field = geomagnetic_field(cx, item)?;
-                out.push(Box::new(crate::effectors::MagneticDipole {
-                    name: name_of(&m.name),
-                    orbit: orbit.clone(),
-                    field,
-                    moment: v,
-                }));
+                let orbit = needs_orbit()?;
+                out.push(Box::new(magnetic_dipole::build(
+                    &ck,
+                    cx,
+                    m,
+                    name_of(&m.name),
+                    orbit,
+                    item,
+                )?));
             }
             EffectorSpec::Magnetorquer(m) => {
                 let orbit = needs_orbit()?;
