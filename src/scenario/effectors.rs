@@ -11,6 +11,7 @@ use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::path::Path;
 
+mod aerodynamic;
 mod energy_sink;
 mod gravity_gradient;
 mod hinged_rod;
@@ -19,10 +20,12 @@ mod magnetorquer;
 mod modal_appendage;
 mod rayleigh;
 mod slosh_pendulum;
+mod solar_pressure;
 mod spring_mass_damper;
 mod wheel;
 mod wheel_damper;
 
+use aerodynamic::AerodynamicSpec;
 use energy_sink::EnergySinkSpec;
 use gravity_gradient::GravityGradientSpec;
 use hinged_rod::HingedRodSpec;
@@ -31,6 +34,7 @@ use magnetorquer::MagnetorquerSpec;
 use modal_appendage::ModalSpec;
 use rayleigh::RayleighSpec;
 use slosh_pendulum::SloshPendulumSpec;
+use solar_pressure::SolarPressureSpec;
 use spring_mass_damper::SpringMassSpec;
 use wheel::MotorWheelSpec;
 use wheel_damper::WheelSpec;
@@ -67,68 +71,6 @@ pub enum EffectorSpec {
     /// `body.shape` (needs `orbit:`).
     Aerodynamic(AerodynamicSpec),
 }
-
-/// `aerodynamic:` — drag in the exponential atmosphere of Vallado's Table 8-4, either on a
-/// constant projected area at a fixed centre of pressure (`area`, `center_of_pressure`), or
-/// on the facets of `body.shape` (`from_shape: true`).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AerodynamicSpec {
-    /// Name (default `aerodynamic`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Drag coefficient C_d (dimensionless; 2.2 is customary in LEO).
-    pub drag_coefficient: Spanned<f64>,
-    /// Projected area A (m²), the same for every attitude.
-    #[serde(default)]
-    pub area: Option<Spanned<f64>>,
-    /// Centre of pressure (m, body axes, about the hub's centre of mass).
-    #[serde(default)]
-    pub center_of_pressure: Option<Spanned<[f64; 3]>>,
-    /// `true`: drag on the facets of `body.shape`, whose projected area and centre of
-    /// pressure follow the attitude, instead of `area` and `center_of_pressure`.
-    #[serde(default)]
-    pub from_shape: Option<Spanned<bool>>,
-    /// With `from_shape`, where the centre of `body.shape` is (m, body axes, about the centre
-    /// of mass; default the centre of mass).
-    #[serde(default)]
-    pub shape_center: Option<Spanned<[f64; 3]>>,
-}
-
-/// Largest `aerodynamic` drag coefficient: free-molecular flat plates and spheres are 2 to 3.
-pub const MAX_DRAG_COEFFICIENT: f64 = 10.0;
-
-/// Largest distance (m) of an `aerodynamic` centre of pressure from the centre of mass.
-pub const MAX_CENTER_OF_PRESSURE: f64 = 1e3;
-
-/// `solar_pressure:` — one flat plate in the Sun's radiation, one-sided, in the Earth's
-/// cylindrical shadow.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SolarPressureSpec {
-    /// Name (default `solar_pressure`).
-    #[serde(default)]
-    pub name: Option<String>,
-    /// Plate area (m²).
-    pub area: Spanned<f64>,
-    /// Normal of the plate's sunlit face (body axes; normalised).
-    pub normal: Spanned<[f64; 3]>,
-    /// Centre of pressure relative to the hub's centre of mass (m, body axes).
-    pub center_of_pressure: Spanned<[f64; 3]>,
-    /// Specular reflectivity ρs (0 to 1).
-    pub specular: Spanned<f64>,
-    /// Diffuse reflectivity ρd (0 to 1, ρs + ρd ≤ 1).
-    pub diffuse: Spanned<f64>,
-}
-
-/// Largest distance of a `solar_pressure` centre of pressure from the hub's centre of mass
-/// (m).
-pub const MAX_PRESSURE_ARM: f64 = 1e3;
-/// Unix time (s) of 2050-01-01T00:00Z, the end of the span of the low-precision solar
-/// coordinates (1950–2050).
-pub const SOLAR_EPHEMERIS_END_UNIX_S: f64 = 2_524_608_000.0;
-/// 1950-01-01T00:00:00Z as Unix seconds: the start of the same span.
-pub const SOLAR_EPHEMERIS_START_UNIX_S: f64 = -631_152_000.0;
 
 /// `copies: {count: 4, about: [0, 0, 1]}`: identical copies turned evenly about a body axis
 /// through the hub's centre of mass (e.g. turnstile antennas).
@@ -454,210 +396,26 @@ pub(super) fn build(
                 )?));
             }
             EffectorSpec::SolarPressure(sp) => {
-                let orbit = &needs_orbit()?;
-                let area = ck.positive(&sp.area, "area", "m²")?;
-                let Some(n) = super::unit_vector(&Vector3::from(sp.normal.value)) else {
-                    let num = crate::timefmt::number;
-                    return Err(ck.err(
-                        &sp.normal,
-                        "normal",
-                        format!(
-                            "expected a non-zero vector of three finite numbers (body axes), \
-                             got [{}, {}, {}]",
-                            num(sp.normal.value[0]),
-                            num(sp.normal.value[1]),
-                            num(sp.normal.value[2])
-                        ),
-                    ));
-                };
-                let r_cp = Vector3::from(sp.center_of_pressure.value);
-                if !r_cp.iter().all(|c| c.is_finite()) || r_cp.norm() > MAX_PRESSURE_ARM {
-                    return Err(ck.err(
-                        &sp.center_of_pressure,
-                        "center_of_pressure",
-                        format!(
-                            "expected three finite numbers within {MAX_PRESSURE_ARM:e} m of \
-                             the centre of mass (m, body axes), got [{}, {}, {}]",
-                            sp.center_of_pressure.value[0],
-                            sp.center_of_pressure.value[1],
-                            sp.center_of_pressure.value[2]
-                        ),
-                    ));
-                }
-                let mut rho = [0.0; 2];
-                for (k, (v, key)) in [(&sp.specular, "specular"), (&sp.diffuse, "diffuse")]
-                    .into_iter()
-                    .enumerate()
-                {
-                    if !(0.0..=1.0).contains(&v.value) {
-                        return Err(ck.err(
-                            v,
-                            key,
-                            format!(
-                                "expected a reflectivity from 0 to 1, got {}",
-                                super::number(v.value)
-                            ),
-                        ));
-                    }
-                    rho[k] = v.value;
-                }
-                if rho[0] + rho[1] > 1.0 {
-                    return Err(ck.err(
-                        &sp.diffuse,
-                        "diffuse",
-                        format!(
-                            "expected specular + diffuse at most 1 (the rest is absorbed), got \
-                             {} + {} = {}",
-                            rho[0],
-                            rho[1],
-                            rho[0] + rho[1]
-                        ),
-                    ));
-                }
-                let epoch_s = cx.epoch_unix_ns as f64 * 1e-9;
-                if !(SOLAR_EPHEMERIS_START_UNIX_S..SOLAR_EPHEMERIS_END_UNIX_S).contains(&epoch_s) {
-                    return Err(ScenarioError::at(
-                        cx.path,
-                        cx.epoch_loc.or(item),
-                        "epoch",
-                        "the low-precision solar coordinates (Vallado Algorithm 29) hold from \
-                         1950 to 2050: choose an epoch from 1950-01-01 to before 2050-01-01",
-                    ));
-                }
-                out.push(Box::new(crate::effectors::SolarPressure {
-                    name: name_of(&sp.name),
-                    orbit: orbit.clone(),
-                    epoch_unix_ns: cx.epoch_unix_ns,
-                    area,
-                    normal: n,
-                    center_of_pressure: r_cp + cx.shift,
-                    specular: rho[0],
-                    diffuse: rho[1],
-                }));
+                let orbit = needs_orbit()?;
+                out.push(Box::new(solar_pressure::build(
+                    &ck,
+                    cx,
+                    sp,
+                    name_of(&sp.name),
+                    orbit,
+                    item,
+                )?));
             }
             EffectorSpec::Aerodynamic(a) => {
-                let orbit = &needs_orbit()?;
-                let cd = a.drag_coefficient.value;
-                if !(cd > 0.0 && cd <= MAX_DRAG_COEFFICIENT) {
-                    return Err(ck.err(
-                        &a.drag_coefficient,
-                        "drag_coefficient",
-                        format!(
-                            "expected a value in (0, {MAX_DRAG_COEFFICIENT}] (dimensionless; \
-                             2.2 is customary in LEO), got {}",
-                            super::number(cd)
-                        ),
-                    ));
-                }
-                let arm = |s: &Spanned<[f64; 3]>, key: &str| {
-                    let p = Vector3::from(s.value);
-                    if p.iter().all(|c| c.is_finite()) && p.norm() <= MAX_CENTER_OF_PRESSURE {
-                        Ok(p)
-                    } else {
-                        Err(ck.err(
-                            s,
-                            key,
-                            format!(
-                                "expected three finite numbers within \
-                                 {MAX_CENTER_OF_PRESSURE:e} m of the centre of mass (m, body \
-                                 axes), got [{}, {}, {}]",
-                                s.value[0], s.value[1], s.value[2]
-                            ),
-                        ))
-                    }
-                };
-                let name = name_of(&a.name);
-                match (&a.from_shape, &a.area, &a.center_of_pressure) {
-                    (Some(f), area, cp) if f.value => {
-                        if let Some(s) = area {
-                            return Err(ck.err(
-                                s,
-                                "area",
-                                "with `from_shape: true` the projected area follows from \
-                                 `body.shape` and the attitude: remove `area`, or \
-                                 `from_shape` for a constant area",
-                            ));
-                        }
-                        if let Some(s) = cp {
-                            return Err(ck.err(
-                                s,
-                                "center_of_pressure",
-                                "with `from_shape: true` the centre of pressure follows from \
-                                 `body.shape` and the attitude: remove `center_of_pressure` \
-                                 (`shape_center` places the shape relative to the centre of \
-                                 mass)",
-                            ));
-                        }
-                        let Some(shape) = cx.shape else {
-                            return Err(ck.err(
-                                f,
-                                "from_shape",
-                                "drag on the body's facets needs `body.shape`: a box \
-                                 `{box: {size: [x, y, z]}}` or a cylinder `{cylinder: \
-                                 {radius: r, length: l, axis: [0, 0, 1]}}` (m, body axes)",
-                            ));
-                        };
-                        let center = match &a.shape_center {
-                            Some(s) => arm(s, "shape_center")?,
-                            None => Vector3::zeros(),
-                        } + cx.shift;
-                        use crate::effectors::aerodynamic::facets::DragSurface;
-                        let surface = match shape {
-                            Shape::Box { size, orientation } => {
-                                DragSurface::cuboid(*size, orientation, center)
-                            }
-                            Shape::Cylinder {
-                                radius,
-                                length,
-                                orientation,
-                            } => DragSurface::cylinder(*radius, *length, orientation, center),
-                        };
-                        out.push(Box::new(crate::effectors::aerodynamic::ShapeAerodynamic {
-                            name,
-                            orbit: orbit.clone(),
-                            drag_coefficient: cd,
-                            surface,
-                        }));
-                    }
-                    (_, Some(area), Some(cp)) => {
-                        if let Some(s) = &a.shape_center {
-                            return Err(ck.err(
-                                s,
-                                "shape_center",
-                                "`shape_center` places `body.shape` for `from_shape: true`; \
-                                 with a constant `area` the drag acts at `center_of_pressure`",
-                            ));
-                        }
-                        let area = ck.positive(area, "area", "m²")?;
-                        let cp = arm(cp, "center_of_pressure")?;
-                        out.push(Box::new(crate::effectors::Aerodynamic {
-                            name,
-                            orbit: orbit.clone(),
-                            drag_coefficient: cd,
-                            area,
-                            center_of_pressure: cp + cx.shift,
-                        }));
-                    }
-                    (_, Some(_), None) => {
-                        return Err(ScenarioError::at(
-                            cx.path,
-                            item,
-                            ck.prefix.clone(),
-                            "missing field `center_of_pressure`: a constant `area` acts at a \
-                             fixed centre of pressure (m, body axes, about the centre of mass)",
-                        ));
-                    }
-                    (_, None, _) => {
-                        return Err(ScenarioError::at(
-                            cx.path,
-                            item,
-                            ck.prefix.clone(),
-                            "expected `area` (m²) and `center_of_pressure` (m, body axes) for a \
-                             constant projected area, or `from_shape: true` for drag on the \
-                             facets of `body.shape`",
-                        ));
-                    }
-                }
+                let orbit = needs_orbit()?;
+                out.push(aerodynamic::build(
+                    &ck,
+                    cx,
+                    a,
+                    name_of(&a.name),
+                    orbit,
+                    item,
+                )?);
             }
             EffectorSpec::Rayleigh(r) => {
                 out.push(Box::new(rayleigh::build(
