@@ -2,9 +2,14 @@
 //!
 //! Each list item is a one-key mapping naming the kind, e.g. `- hinged_rod: {mass: 0.139, …}`.
 //! Every physical parameter keeps its span, so an unphysical value is reported at its line.
+//!
+//! Each kind has its own file in `effectors/` (`rayleigh.rs`, `hinged_rod.rs`, …, and
+//! `hub_motion.rs`): its spec, a short YAML example, and the `build` that validates and
+//! constructs it. This file keeps the `EffectorSpec` list item, the shared checks (`Check`,
+//! placement on `body.shape`, `copies:`), the `Context`, and `build`, which dispatches each
+//! item to its kind and then checks the kinds against each other.
 
 use super::{MAX_MAGNITUDE, MIN_POSITIVE, ScenarioError, Shape, loc};
-use crate::effectors::SpinUp;
 use crate::model::{Effector, RigidBody};
 use nalgebra::{UnitQuaternion, Vector3};
 use serde::Deserialize;
@@ -15,6 +20,7 @@ mod aerodynamic;
 mod energy_sink;
 mod gravity_gradient;
 mod hinged_rod;
+mod hub_motion;
 mod magnetic_dipole;
 mod magnetorquer;
 mod modal_appendage;
@@ -38,6 +44,9 @@ use solar_pressure::SolarPressureSpec;
 use spring_mass_damper::SpringMassSpec;
 use wheel::MotorWheelSpec;
 use wheel_damper::WheelSpec;
+
+pub use hub_motion::HubMotionSpec;
+pub(super) use hub_motion::build as motion;
 
 /// One entry of `effectors:`.
 #[derive(Debug, Deserialize)]
@@ -81,21 +90,6 @@ pub struct CopiesSpec {
     pub count: Spanned<u32>,
     /// Axis they are turned about (body axes).
     pub about: Spanned<[f64; 3]>,
-}
-
-/// `hub_motion:`: a prescribed hub rotation.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "snake_case")]
-pub enum HubMotionSpec {
-    /// The smooth spin-up of Kane, Ryan & Banerjee (1987).
-    SpinUp {
-        /// Spin axis (body axes).
-        axis: Spanned<[f64; 3]>,
-        /// Final rate (rad/s).
-        rate: Spanned<f64>,
-        /// Ramp duration (s).
-        ramp_time: Spanned<f64>,
-    },
 }
 
 /// Builds located errors for one effector entry.
@@ -560,24 +554,5 @@ fn copy_name(base: &str, k: usize, count: usize) -> String {
         format!("{base}_{}", k + 1)
     } else {
         base.to_string()
-    }
-}
-
-/// Validates `hub_motion:`.
-pub(super) fn motion(path: &Path, spec: &HubMotionSpec) -> Result<SpinUp, ScenarioError> {
-    let ck = Check {
-        path,
-        prefix: "hub_motion.spin_up".into(),
-    };
-    match spec {
-        HubMotionSpec::SpinUp {
-            axis,
-            rate,
-            ramp_time,
-        } => Ok(SpinUp {
-            axis: ck.unit(axis, "axis")?,
-            rate: ck.finite(&Some(rate.clone()), "rate", "rad/s")?,
-            ramp_time: ck.positive(ramp_time, "ramp_time", "s")?,
-        }),
     }
 }
