@@ -17,10 +17,10 @@
 //! The angles are singular where the rod lies along ±p̂₃ (θ = ±90°): φ is then undefined and
 //! the coordinate mass m l² cos² θ vanishes. The run stops there with a diagnosis.
 
-use super::particles::{ParticleModel, ParticlePoint};
-use crate::model::{Drawing, Validity};
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
 use crate::sincos::sin_cos;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 /// A damped spherical pendulum.
 #[derive(Debug, Clone)]
@@ -103,6 +103,49 @@ impl SloshPendulum {
     }
 }
 
+/// The bob's kinematics at one state, for the closed forms.
+struct Terms {
+    /// Rod direction ê.
+    e: Vector3<f64>,
+    /// Jacobian columns j_φ = l cos θ â and j_θ = l ∂ê/∂θ (m/rad).
+    columns: [Vector3<f64>; 2],
+    /// |j_φ|² and |j_θ|² (m²/rad²).
+    lengths: [f64; 2],
+    /// Bob position r = d + l ê (m, body axes).
+    r: Vector3<f64>,
+    /// Its acceleration at ω̇ = 0 and u̇ = 0 relative to the hub's centre:
+    /// c = ω × (ω × r) + 2 ω × J u + l κ (m/s²).
+    free: Vector3<f64>,
+    /// The dashpot's force on the bob, −c J u (N).
+    dashpot: Vector3<f64>,
+}
+
+impl SloshPendulum {
+    /// [`Terms`] at angles `q`, rates `u` and hub rate `omega`; `None` at the angles'
+    /// singularity (cos θ = 0), where the general path stops the run.
+    #[inline(always)]
+    fn terms(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Terms> {
+        let [e, e_phi, e_theta, kappa] = self.directions(q, u);
+        let l = self.length;
+        let columns = [l * e_phi, l * e_theta];
+        let lengths = [columns[0].norm_squared(), l * l];
+        if lengths[0].is_nan() || lengths[0] <= 0.0 {
+            return None;
+        }
+        let r = self.pivot + l * e;
+        let velocity = columns[0] * u[0] + columns[1] * u[1];
+        let free = omega.cross(&omega.cross(&r)) + 2.0 * omega.cross(&velocity) + l * kappa;
+        Some(Terms {
+            e,
+            columns,
+            lengths,
+            r,
+            free,
+            dashpot: -self.damping * velocity,
+        })
+    }
+}
+
 impl ParticleModel for SloshPendulum {
     type Cache = [Vector3<f64>; 4];
     fn prepare(&self, q: &[f64], u: &[f64]) -> Self::Cache {
@@ -141,6 +184,142 @@ impl ParticleModel for SloshPendulum {
         out.jacobian[0] = l * e_phi;
         out.jacobian[1] = l * e_theta;
         out.convective = l * kappa;
+    }
+    /// One particle with orthogonal Jacobian columns: the sums written out.
+    fn summed<const N: usize>(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        out: &mut ParticleSums<N>,
+    ) -> bool {
+        let Some(t) = self.terms(q, u, omega) else {
+            return false;
+        };
+        let m = self.mass;
+        for k in 0..2 {
+            let mj = m * t.columns[k];
+            let moment = t.r.cross(&mj);
+            out.mass[k][k] = m * t.lengths[k];
+            out.coupling[k] = [mj.x, mj.y, mj.z, moment.x, moment.y, moment.z];
+            out.inertial[k] = -mj.dot(&t.free);
+        }
+        let r = t.r;
+        out.total_mass = m;
+        out.first_moment = m * r;
+        out.inertia = m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+        out.force = m * t.free;
+        out.moment = r.cross(&out.force);
+        true
+    }
+    /// The rod transmits force to the bob only along ê, and the angles move it freely ⊥ ê
+    /// (the Jacobian columns span that plane), so with Φ z = a_B + ω̇ × r the elimination is
+    ///
+    /// ```text
+    /// D − C M⁻¹ Cᵀ = m v vᵀ,  v = [ê; r × ê],   e + C M⁻¹ g = [f; r × f],  f = m ê (ê·c) + F,
+    /// ```
+    ///
+    /// with F the dashpot's force (⊥ ê): a point mass constrained along the rod only.
+    fn couple_closed_form(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        coupling: &mut HubCoupling,
+        kept: &mut [f64],
+    ) -> bool {
+        let Some(t) = self.terms(q, u, omega) else {
+            return false;
+        };
+        let m = self.mass;
+        let pull = (m * t.e.dot(&t.free)) * t.e + t.dashpot;
+        let moment = t.r.cross(&pull);
+        for i in 0..3 {
+            coupling.force[i] -= pull[i];
+            coupling.force[3 + i] -= moment[i];
+        }
+        let re = t.r.cross(&t.e);
+        let v = [t.e.x, t.e.y, t.e.z, re.x, re.y, re.z];
+        let hub = &mut coupling.mass;
+        for i in 0..6 {
+            let m_vi = m * v[i];
+            for j in 0..=i {
+                hub[(i, j)] += m_vi * v[j];
+            }
+        }
+        // W_k = [g_k, Cᵀ_k] / M_kk with M_kk = m |j_k|², g_k = j_k·F − m j_k·c and
+        // Cᵀ_k = m [j_k; r × j_k]; L = 1.
+        for k in 0..2 {
+            let (j, inv) = (t.columns[k], 1.0 / t.lengths[k]);
+            let rj = t.r.cross(&j);
+            let row = &mut kept[7 * k..7 * k + 7];
+            row[0] = (j.dot(&t.dashpot) / m - j.dot(&t.free)) * inv;
+            for a in 0..3 {
+                row[1 + a] = j[a] * inv;
+                row[4 + a] = rj[a] * inv;
+            }
+        }
+        kept[14..17].copy_from_slice(&[1.0, 0.0, 1.0]);
+        true
+    }
+    const HAS_RHS_ALONE: bool = true;
+    /// The pendulum alone on the hub: with the system's centre of mass fixed, the bob moves as
+    /// one of reduced mass m* = m M/(M + m) about a fixed hub centre (as the spring–mass
+    /// damper's two-body reduction), and the elimination above leaves a rank-one update of
+    /// the hub's inertia (t = r × ê):
+    ///
+    /// ```text
+    /// (I + m* t tᵀ) ω̇ = −ω × Iω − r × (m* ê (ê·c) + F),
+    /// q̈_k = (j_k·F/m* − j_k·(ω̇ × r + c)) / |j_k|².
+    /// ```
+    fn rhs_alone_closed_form(
+        &self,
+        q: &[f64],
+        u: &[f64],
+        omega: &Vector3<f64>,
+        hub_inertia: &Matrix3<f64>,
+        hub_mass: f64,
+        omega_dot: &mut Vector3<f64>,
+        u_dot: &mut [f64],
+    ) -> bool {
+        let Some(t) = self.terms(q, u, omega) else {
+            return false;
+        };
+        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
+        let pull = (m_star * t.e.dot(&t.free)) * t.e + t.dashpot;
+        let force = -omega.cross(&(hub_inertia * omega)) - t.r.cross(&pull);
+        let arm = t.r.cross(&t.e);
+        let entry = |i: usize, j: usize| hub_inertia[(i, j)] + m_star * arm[i] * arm[j];
+        let Some(inverse) = spd_inverse3(
+            entry(0, 0),
+            entry(1, 0),
+            entry(2, 0),
+            entry(1, 1),
+            entry(2, 1),
+            entry(2, 2),
+        ) else {
+            return false;
+        };
+        let w = inverse * force;
+        let a = w.cross(&t.r) + t.free;
+        for ((out, j), length) in u_dot.iter_mut().zip(&t.columns).zip(&t.lengths) {
+            *out = (j.dot(&t.dashpot) / m_star - j.dot(&a)) / length;
+        }
+        *omega_dot = w;
+        true
+    }
+    fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
+        let [e, e_phi, e_theta, _] = self.directions(q, u);
+        let (m, l) = (self.mass, self.length);
+        let r = self.pivot + l * e;
+        let v = omega.cross(&r) + l * (u[0] * e_phi + u[1] * e_theta);
+        Some(Momentum {
+            mass: m,
+            first_moment: m * r,
+            linear: m * v,
+            angular: m * r.cross(&v),
+            kinetic_energy: 0.5 * m * v.norm_squared(),
+        })
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {
         // J's columns are orthogonal, of lengths l cos θ and l.
