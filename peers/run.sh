@@ -46,6 +46,7 @@ if [[ $report_only == 0 ]]; then
   "$VENV/bin/python" "$PEERS/bench.py"
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
+    "$VENV/bin/python" "$PEERS/basilisk_slosh.py"
     "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
   # polhode's environmental torques at the states of results/basilisk_environment.json.
