@@ -49,6 +49,9 @@ if [[ $report_only == 0 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_slosh.py"
     "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
+  # slosh_pendulum along Basilisk's sphericalPendulum trajectories (results/basilisk_slosh.json).
+  echo "[run] polhode's slosh_pendulum against Basilisk's trajectories (tests/basilisk_slosh.rs)"
+  (cd "$ROOT" && cargo test --release --locked --quiet --test basilisk_slosh)
   # polhode's environmental torques at the states of results/basilisk_environment.json.
   echo "[run] polhode's environmental torques at Basilisk's states (tests/basilisk_environment.rs)"
   (cd "$ROOT" && POLHODE_PEER_OUT="$PEERS/results/basilisk_environment_polhode.json" \
