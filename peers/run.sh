@@ -6,7 +6,7 @@
 # docs/peers.md. Needs cargo and python3 >= 3.9 (bsk 2.12.1 is one abi3 wheel,
 # cp39-abi3-manylinux_2_28_x86_64; used here with CPython 3.11).
 #
-#   peers/run.sh                 everything (about 4 min once built; the first build of
+#   peers/run.sh                 everything (about 5 min once built; the first build of
 #                                peers/rust-ode compiles polhode's dependencies again: ~9 min)
 #   peers/run.sh --no-basilisk   skip the Basilisk part
 #   peers/run.sh --report-only   regenerate docs/peers.md from peers/results/
