@@ -34,6 +34,7 @@ pub mod motor_wheel;
 pub mod particles;
 pub mod rayleigh;
 pub mod rod_lanes;
+pub mod slosh_analog;
 pub mod solar_pressure;
 pub mod spring_mass;
 pub mod wheel;
