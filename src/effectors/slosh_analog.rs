@@ -1028,6 +1028,33 @@ mod tests {
     }
 
     #[test]
+    fn first_mode_obeys_the_modal_sum_rule() {
+        // Over all modes Σ m_n L_n = ρ I_F, I_F = π a⁴/4 the free surface's second moment
+        // about a diameter (completeness of the modes on F, Bessel's inequality for any one):
+        // the first mode alone must stay below it. For the cylinder the ratio is exactly
+        // 8/(ξ₁²(ξ₁² − 1)) = 0.9874 at every depth (tolerance 1e-12, rounding).
+        for &f in &[0.02, 0.1, 0.3, 0.5, 0.7, 0.9, 0.95] {
+            let r: f64 = 0.7;
+            let a = slosh_analog(&Tank::Sphere { radius: r }, f, &WATER, 9.81).unwrap();
+            let surface_radius_sq = a.depth * (2.0 * r - a.depth);
+            let i_f = PI * surface_radius_sq * surface_radius_sq / 4.0;
+            let ratio = a.slosh_mass * a.pendulum_length / (WATER.density * i_f);
+            assert!(ratio < 1.0 && ratio > 0.0, "f = {f}: {ratio}");
+            // The sphere's moment-matched fixed mass sits at the centre (m_liquid z_cm =
+            // −ρ I_F for a spherical cap); the static one is below it by the shortfall.
+            assert!(rel(a.liquid_mass * a.liquid_cm_height, -WATER.density * i_f) < 1e-12);
+        }
+        let xi = XI_1;
+        for &f in &[0.05, 0.4, 0.9] {
+            let (radius, height) = (0.5, 2.0);
+            let a = slosh_analog(&Tank::Cylinder { radius, height }, f, &WATER, 9.81).unwrap();
+            let i_f = PI * radius.powi(4) / 4.0;
+            let ratio = a.slosh_mass * a.pendulum_length / (WATER.density * i_f);
+            assert!(rel(ratio, 8.0 / (xi * xi * (xi * xi - 1.0))) < 1e-12);
+        }
+    }
+
+    #[test]
     fn slosh_mass_and_frequency_move_the_right_way_with_fill() {
         // Sphere: as the fill rises the free surface shrinks, so ω₁²R/g rises and the
         // sloshing share of the liquid falls (monotone on the range provided).
