@@ -148,3 +148,117 @@ fn the_angle_singularity_stops_the_run() {
         out.status
     );
 }
+
+/// A two-tank stage with spherical tanks given as tanks: the analog follows from the tank in
+/// the spin's centrifugal field.
+fn tanks(fill: f64, centre_x: f64, extra: &str) -> String {
+    format!(
+        "name: t\nbody: {{mass: 800.0, principal: [900.0, 900.0, 250.0], spin_axis: [0, 0, 1]}}\n\
+         initial: {{omega: [0.0, 0.0, 5.0]}}\nduration: 1.0\neffectors:\n\
+         \x20 - slosh_pendulum:\n      name: a\n{extra}      tank:\n        \
+         shape: {{sphere: {{radius: 0.22}}}}\n        center: [{centre_x}, 0.0, 0.2]\n        \
+         fill: {fill}\n        liquid: {{density: 1004.0, kinematic_viscosity: 9.7e-7, \
+         surface_tension: 0.066}}\n\
+         \x20 - slosh_pendulum:\n      name: b\n      tank:\n        \
+         shape: {{sphere: {{radius: 0.22}}}}\n        center: [-{centre_x}, 0.0, 0.2]\n        \
+         fill: {fill}\n        liquid: {{density: 1004.0, kinematic_viscosity: 9.7e-7, \
+         surface_tension: 0.066}}\n"
+    )
+}
+
+/// The analog built from a tank holds the tank's liquid, with its centre of mass where the
+/// liquid at rest has it: a half-full sphere is a hemisphere of liquid on the outer side,
+/// of mass ρ (2/3) π R³ and centre of mass 3R/8 outward from the tank's centre (a fact of
+/// the geometry, not of the analog).
+#[test]
+fn a_tank_s_analog_holds_its_liquid_where_the_liquid_rests() {
+    use polhode::model::HubState;
+    use std::f64::consts::PI;
+    let (rho, radius, centre) = (1004.0, 0.22_f64, nalgebra::Vector3::new(0.7, 0.0, 0.2));
+    let s = scenario(&tanks(0.5, 0.7, ""));
+    let sc = &s.spacecraft;
+    let y = sc.initial_state(&s.omega0, &s.attitude0);
+    let hub = HubState {
+        t: 0.0,
+        omega: s.omega0,
+        attitude: &y[3..7],
+    };
+    let offset = sc.effector_offset(0);
+    let tank = &sc.effectors()[0];
+    let p = tank.momentum(&hub, &y[offset..offset + tank.num_states()]);
+    let liquid = rho * 2.0 / 3.0 * PI * radius.powi(3);
+    assert!(
+        (p.mass - liquid).abs() < 1e-12 * liquid,
+        "{} against {liquid}",
+        p.mass
+    );
+    let expected = centre + 3.0 * radius / 8.0 * nalgebra::Vector3::x();
+    let at = p.first_moment / p.mass;
+    assert!(
+        (at - expected).norm() < 1e-9 * radius,
+        "{at} against {expected}"
+    );
+}
+
+/// In the spinning frame the tank's pendulum swings at the analog's ω₁ = √(g/L), g = Ω² r_T,
+/// in the plane of the spin (the sphere's pivot is its centre, at r_T from the axis, so the
+/// closed form Ω √(b/l) of the first test is √(g/L)): `linearize` on a hub that holds the
+/// spin finds it, damped at the analog's ζ.
+#[test]
+fn a_tank_s_pendulum_swings_at_the_analog_s_frequency() {
+    use polhode::effectors::slosh_analog::{Liquid, Tank, slosh_analog};
+    let analog = slosh_analog(
+        &Tank::Sphere { radius: 0.22 },
+        0.6,
+        &Liquid {
+            density: 1004.0,
+            kinematic_viscosity: 9.7e-7,
+            surface_tension: 0.066,
+        },
+        25.0 * 0.7,
+    )
+    .unwrap();
+    let yaml = tanks(0.6, 0.7, "").replace(
+        "body: {mass: 800.0, principal: [900.0, 900.0, 250.0]",
+        "body: {mass: 1.0e11, principal: [1.0e11, 1.05e11, 1.1e11]",
+    );
+    let s = scenario(&yaml);
+    let lin = linearize(&s.spacecraft, spin_rate_of(&s.spacecraft, &s.omega0)).unwrap();
+    let zeta = analog.damping_ratio;
+    let (re, im) = (
+        -zeta * analog.frequency,
+        analog.frequency * (1.0 - zeta * zeta).sqrt(),
+    );
+    let near: Vec<_> = lin
+        .modes
+        .iter()
+        .filter(|m| m.im > 0.0 && (m.im - im).abs() < 1e-6 * im)
+        .collect();
+    assert_eq!(near.len(), 2, "{:?} against {im}", lin.modes);
+    for m in near {
+        assert!((m.re - re).abs() < 1e-6 * im, "{} against {re}", m.re);
+    }
+}
+
+/// What a tank cannot stand for is refused at load, at its field.
+#[test]
+fn tanks_outside_the_analog_s_range_are_refused() {
+    use polhode::scenario::{Overrides, parse};
+    let refuse = |yaml: String, words: &str| {
+        let e = parse(std::path::Path::new("t.yaml"), yaml, &Overrides::default())
+            .expect_err(words)
+            .to_string();
+        assert!(e.contains(words), "{e}");
+    };
+    // On the spin axis: no centrifugal field to restore the liquid.
+    refuse(tanks(0.5, 0.0, ""), "tank.center");
+    // Near it: the field varies by more than half across the tank.
+    refuse(tanks(0.5, 0.3, ""), "no longer describes the liquid");
+    // A fill fraction outside the analog's range.
+    refuse(tanks(0.99, 0.7, ""), "tank.fill");
+    // A pendulum key beside the tank.
+    refuse(
+        tanks(0.5, 0.7, "      mass: 3.0\n"),
+        "`mass` and `tank` are both given",
+    );
+}

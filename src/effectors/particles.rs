@@ -1075,6 +1075,17 @@ mod tests {
                 pivot: Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)),
                 frame: pendulum_frame(rest.normalize()),
                 damping: uniform(0.0, 50.0),
+                fixed_mass: if uniform(0.0, 1.0) < 0.5 {
+                    0.0
+                } else {
+                    uniform(0.5, 40.0)
+                },
+                fixed_position: Vector3::new(
+                    uniform(-1.0, 1.0),
+                    uniform(-1.0, 1.0),
+                    uniform(-1.0, 1.0),
+                ),
+                amplitude_warning: None,
             };
             let e = ParticleEffector::new("p", pendulum, &[0.0; 2], &[0.0; 2]);
             let x = [

@@ -17,7 +17,7 @@
 //! The angles are singular where the rod lies along ±p̂₃ (θ = ±90°): φ is then undefined and
 //! the coordinate mass m l² cos² θ vanishes. The run stops there with a diagnosis.
 
-use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use super::particles::{ParticleModel, ParticlePoint, ParticleSums, add_mass_and_first_moment};
 use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
 use crate::sincos::sin_cos;
 use nalgebra::{Matrix3, Vector3};
@@ -36,6 +36,14 @@ pub struct SloshPendulum {
     pub frame: [Vector3<f64>; 3],
     /// Dashpot coefficient c on the mass's velocity relative to the body (N s/m).
     pub damping: f64,
+    /// The tank's non-sloshing liquid (kg), a point mass fixed in the body at
+    /// `fixed_position`; zero for a bare pendulum.
+    pub fixed_mass: f64,
+    /// Where the non-sloshing liquid sits (m, body axes, about the hub's centre of mass).
+    pub fixed_position: Vector3<f64>,
+    /// The swing (rad) past which a tank's analog leaves its small-amplitude range (warned);
+    /// `None` for a bare pendulum, whose only range is its angles'.
+    pub amplitude_warning: Option<f64>,
 }
 
 /// |cos θ| below which the pendulum is at its coordinate singularity: θ within 2.9° of ±90°,
@@ -167,16 +175,25 @@ impl ParticleModel for SloshPendulum {
         vec!["phi".into(), "theta".into()]
     }
     fn num_particles(&self) -> usize {
-        1
+        if self.fixed_mass > 0.0 { 2 } else { 1 }
     }
     fn particle(
         &self,
-        _p: usize,
+        p: usize,
         cache: &Self::Cache,
         _q: &[f64],
         _u: &[f64],
         out: &mut ParticlePoint,
     ) {
+        if p == 1 {
+            // The non-sloshing liquid: fixed in the body.
+            out.mass = self.fixed_mass;
+            out.position = self.fixed_position;
+            out.jacobian[0] = Vector3::zeros();
+            out.jacobian[1] = Vector3::zeros();
+            out.convective = Vector3::zeros();
+            return;
+        }
         let [e, e_phi, e_theta, kappa] = *cache;
         let l = self.length;
         out.mass = self.mass;
@@ -204,12 +221,16 @@ impl ParticleModel for SloshPendulum {
             out.coupling[k] = [mj.x, mj.y, mj.z, moment.x, moment.y, moment.z];
             out.inertial[k] = -mj.dot(&t.free);
         }
-        let r = t.r;
-        out.total_mass = m;
-        out.first_moment = m * r;
-        out.inertia = m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
-        out.force = m * t.free;
-        out.moment = r.cross(&out.force);
+        let (r, m0, r0) = (t.r, self.fixed_mass, self.fixed_position);
+        let point =
+            |r: &Vector3<f64>| Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose();
+        let force0 = m0 * omega.cross(&omega.cross(&r0));
+        out.total_mass = m + m0;
+        out.first_moment = m * r + m0 * r0;
+        out.inertia = m * point(&r) + m0 * point(&r0);
+        let force = m * t.free;
+        out.force = force + force0;
+        out.moment = r.cross(&force) + r0.cross(&force0);
         true
     }
     /// The rod transmits force to the bob only along ê, and the angles move it freely ⊥ ê
@@ -238,9 +259,27 @@ impl ParticleModel for SloshPendulum {
             coupling.force[i] -= pull[i];
             coupling.force[3 + i] -= moment[i];
         }
+        let hub = &mut coupling.mass;
+        if self.fixed_mass > 0.0 {
+            // The non-sloshing liquid moves with the hub: its D and e as a point mass.
+            let (m0, r0) = (self.fixed_mass, self.fixed_position);
+            add_mass_and_first_moment(hub, m0, &(m0 * r0));
+            let r2 = r0.norm_squared();
+            for i in 0..3 {
+                for j in 0..=i {
+                    let diagonal = if i == j { r2 } else { 0.0 };
+                    hub[(3 + i, 3 + j)] += m0 * (diagonal - r0[i] * r0[j]);
+                }
+            }
+            let force0 = m0 * omega.cross(&omega.cross(&r0));
+            let moment0 = r0.cross(&force0);
+            for i in 0..3 {
+                coupling.force[i] -= force0[i];
+                coupling.force[3 + i] -= moment0[i];
+            }
+        }
         let re = t.r.cross(&t.e);
         let v = [t.e.x, t.e.y, t.e.z, re.x, re.y, re.z];
-        let hub = &mut coupling.mass;
         for i in 0..6 {
             let m_vi = m * v[i];
             for j in 0..=i {
@@ -282,6 +321,11 @@ impl ParticleModel for SloshPendulum {
         omega_dot: &mut Vector3<f64>,
         u_dot: &mut [f64],
     ) -> bool {
+        // With the tank's fixed liquid, three masses share the centre of mass: the general
+        // path then.
+        if self.fixed_mass > 0.0 {
+            return false;
+        }
         let Some(t) = self.terms(q, u, omega) else {
             return false;
         };
@@ -313,12 +357,14 @@ impl ParticleModel for SloshPendulum {
         let (m, l) = (self.mass, self.length);
         let r = self.pivot + l * e;
         let v = omega.cross(&r) + l * (u[0] * e_phi + u[1] * e_theta);
+        let (m0, r0) = (self.fixed_mass, self.fixed_position);
+        let v0 = omega.cross(&r0);
         Some(Momentum {
-            mass: m,
-            first_moment: m * r,
-            linear: m * v,
-            angular: m * r.cross(&v),
-            kinetic_energy: 0.5 * m * v.norm_squared(),
+            mass: m + m0,
+            first_moment: m * r + m0 * r0,
+            linear: m * v + m0 * v0,
+            angular: m * r.cross(&v) + m0 * r0.cross(&v0),
+            kinetic_energy: 0.5 * (m * v.norm_squared() + m0 * v0.norm_squared()),
         })
     }
     fn forces(&self, q: &[f64], u: &[f64], out: &mut [f64]) {
@@ -343,13 +389,39 @@ impl ParticleModel for SloshPendulum {
         vec![self.swing(q).to_degrees()]
     }
     fn validity(&self, q: &[f64]) -> Option<Validity> {
-        Some(Validity {
-            value: folded(q[1]).to_degrees(),
-            warn: THETA_WARN_DEG,
-            limit: SINGULAR_COS_THETA.acos().to_degrees(),
+        let limit = SINGULAR_COS_THETA.acos().to_degrees();
+        Some(match self.amplitude_warning {
+            // The swing bounds |θ| (the rod is at least |θ| from p̂₁), so its limit keeps the
+            // angles clear of their singularity too.
+            Some(amplitude) => Validity {
+                value: self.swing(q).to_degrees(),
+                warn: amplitude.to_degrees(),
+                limit,
+            },
+            None => Validity {
+                value: folded(q[1]).to_degrees(),
+                warn: THETA_WARN_DEG,
+                limit,
+            },
         })
     }
     fn validity_report(&self, q: &[f64]) -> (String, String) {
+        if let Some(amplitude) = self.amplitude_warning {
+            return (
+                format!(
+                    "its rod has swung {:.2}° from rest: past {:.2}° the tank's free-surface \
+                     wave at the wall exceeds 0.1 of the tank radius, beyond the small \
+                     amplitudes the linear slosh analog is derived for (the run stops at \
+                     {:.2}°, where the pendulum's angles are singular)",
+                    self.swing(q).to_degrees(),
+                    amplitude.to_degrees(),
+                    SINGULAR_COS_THETA.acos().to_degrees()
+                ),
+                "more damping (baffles) or a smaller disturbance; large liquid motion needs a \
+                 nonlinear slosh model, which polhode does not have"
+                    .into(),
+            );
+        }
         (
             format!(
                 "its rod has swung to θ = {:.2}°: at ±90° it lies along p̂₃, where the angles \
@@ -366,7 +438,7 @@ impl ParticleModel for SloshPendulum {
     fn drawings(&self, q: &[f64]) -> Vec<Drawing> {
         let bob = self.bob(q);
         let size = (self.mass.cbrt() * 0.05).clamp(0.02, 0.3);
-        vec![
+        let mut drawings = vec![
             Drawing::Line {
                 points: vec![self.pivot, bob],
                 thickness: 0.1 * size,
@@ -375,7 +447,14 @@ impl ParticleModel for SloshPendulum {
                 center: bob,
                 diameter: size,
             },
-        ]
+        ];
+        if self.fixed_mass > 0.0 {
+            drawings.push(Drawing::Sphere {
+                center: self.fixed_position,
+                diameter: (self.fixed_mass.cbrt() * 0.05).clamp(0.02, 0.3),
+            });
+        }
+        drawings
     }
 }
 
@@ -390,6 +469,9 @@ mod tests {
             pivot: Vector3::new(0.2, -0.1, 0.5),
             frame: pendulum_frame(p1.normalize()),
             damping: 1.5,
+            fixed_mass: 0.0,
+            fixed_position: Vector3::zeros(),
+            amplitude_warning: None,
         }
     }
 

@@ -256,6 +256,9 @@ fn a_lone_slosh_pendulum_reduced_by_hand_equals_the_general_path() {
             pivot: Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)),
             frame: pendulum_frame(rest.normalize()),
             damping: uniform(0.0, 50.0),
+            fixed_mass: 0.0,
+            fixed_position: Vector3::zeros(),
+            amplitude_warning: None,
         };
         sc.add_effector(Box::new(ParticleEffector::new(
             "p", pendulum, &[0.0; 2], &[0.0; 2],
