@@ -262,3 +262,45 @@ fn tanks_outside_the_analog_s_range_are_refused() {
         "`mass` and `tank` are both given",
     );
 }
+
+/// `linearize` warns when the energy-sink estimate is outside its assumptions: a lightly
+/// damped pendulum tuned near the nutation frequency (in-plane Ω √(b/l) = 5 √(0.45/1.5) =
+/// 2.7 rad/s against a nutation at about 3 rad/s), and says nothing for the shipped stage.
+#[test]
+fn linearize_warns_when_the_energy_sink_estimate_is_outside_its_assumptions() {
+    let shipped = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/spinning-stage-slosh.yaml"
+    );
+    let linearize = |file: &std::path::Path| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_polhode"))
+            .arg("linearize")
+            .arg(file)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let nominal = linearize(std::path::Path::new(shipped));
+    assert!(nominal.contains("energy-sink estimate"), "{nominal}");
+    assert!(!nominal.contains("warning"), "{nominal}");
+    let text = std::fs::read_to_string(shipped)
+        .unwrap()
+        .replace("length: 0.3 ", "length: 1.5 ")
+        .replace("length: 0.3\n", "length: 1.5\n")
+        .replace("damping: 100.0 ", "damping: 20.0 ")
+        .replace("damping: 100.0\n", "damping: 20.0\n");
+    let file = std::env::temp_dir().join(format!("polhode-slosh-{}.yaml", std::process::id()));
+    std::fs::write(&file, text).unwrap();
+    let tuned = linearize(&file);
+    let _ = std::fs::remove_file(&file);
+    assert!(
+        tuned.contains("warning: the energy-sink estimate is")
+            && tuned.contains("use the eigenvalue"),
+        "{tuned}"
+    );
+}
