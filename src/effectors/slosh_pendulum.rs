@@ -80,6 +80,12 @@ pub fn pendulum_frame(p1: Vector3<f64>) -> [Vector3<f64>; 3] {
     [p1, p2, p3]
 }
 
+/// The pendulum frame of a rest direction `p1` and a pole `p3` (unit, perpendicular, body
+/// axes): [p̂₁, p̂₃ × p̂₁, p̂₃]. The angles are singular where the rod lies along ±p̂₃.
+pub fn pendulum_frame_with_pole(p1: Vector3<f64>, p3: Vector3<f64>) -> [Vector3<f64>; 3] {
+    [p1, p3.cross(&p1), p3]
+}
+
 impl SloshPendulum {
     /// The rod's direction ê, the unit vectors â = ∂ê/∂φ / cos θ and ∂ê/∂θ, and the
     /// convective Σ ∂²ê/∂q_j∂q_k u_j u_k at angles (φ, θ) and rates (φ̇, θ̇).

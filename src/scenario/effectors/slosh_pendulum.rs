@@ -26,7 +26,7 @@ use crate::effectors::slosh_analog::{
     Liquid, SPIN_NONUNIFORMITY_MAX, SloshAnalog, SloshWarning, Tank, slosh_analog, spin_field,
 };
 use crate::effectors::slosh_pendulum::{
-    SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame,
+    SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame, pendulum_frame_with_pole,
 };
 use nalgebra::Vector3;
 use serde::Deserialize;
@@ -58,6 +58,11 @@ pub struct SloshPendulumSpec {
     /// A tank, instead of the five keys above.
     #[serde(default)]
     pub tank: Option<Spanned<TankSpec>>,
+    /// p̂₃, the direction along which the angles are singular (body axes, ⊥ the rest
+    /// direction): choose one the rod will not reach. Default: from the rest direction alone
+    /// (docs/effectors.md), or for a tank the direction tangential to the spin.
+    #[serde(default)]
+    pub pole: Option<Spanned<[f64; 3]>>,
     /// Initial `[φ, θ]` (rad).
     #[serde(default)]
     pub initial_angles: Option<Spanned<[f64; 2]>>,
@@ -165,11 +170,19 @@ pub(super) fn build(
                 .damping
                 .as_ref()
                 .ok_or_else(|| missing("damping", "N s/m"))?;
+            let p1 = ck.unit(rest, "rest_direction")?;
+            let frame = match &spec.pole {
+                Some(pole) => pendulum_frame_with_pole(
+                    p1,
+                    ck.perpendicular(pole, "pole", &p1, "rest_direction")?,
+                ),
+                None => pendulum_frame(p1),
+            };
             SloshPendulum {
                 mass: ck.positive(mass, "mass", "kg")?,
                 length: ck.positive(length, "length", "m")?,
                 pivot: ck.on_body(pivot, "pivot", "the pendulum's pivot", cx)? + cx.shift,
-                frame: pendulum_frame(ck.unit(rest, "rest_direction")?),
+                frame,
                 damping: ck.non_negative(damping, "damping", "N s/m")?,
                 fixed_mass: 0.0,
                 fixed_position: Vector3::zeros(),
@@ -320,13 +333,22 @@ fn from_tank(
             ),
         ));
     }
-    // Heights are along "up", against the field.
+    // Heights are along "up", against the field. The pole is tangential to the spin unless
+    // given: a spin that moves toward another body axis (a flat spin) swings the rod in the
+    // plane of the spin axis and the tank, away from it.
     let up = -down;
+    let frame = match &spec.pole {
+        Some(pole) => pendulum_frame_with_pole(
+            down,
+            ck.perpendicular(pole, "pole", &down, "the tank's field direction")?,
+        ),
+        None => pendulum_frame_with_pole(down, axis.cross(&down).normalize()),
+    };
     Ok(SloshPendulum {
         mass: analog.slosh_mass,
         length: analog.pendulum_length,
         pivot: center + analog.pivot_height * up,
-        frame: pendulum_frame(down),
+        frame,
         damping: analog.dashpot,
         fixed_mass: analog.fixed_mass,
         fixed_position: center + analog.fixed_mass_height * up,
