@@ -276,26 +276,21 @@ impl ReducedDamper {
     }
 }
 
-/// polhode's right-hand side of the nutation-damper scene against [`ReducedDamper`] at the
-/// same state (after checking that they agree).
-fn bench_reduced_damper(repeats: usize) {
+/// Checks that polhode's right-hand side of `sc` and a hand-written `reduced` one agree at
+/// `y` (to 1e-10 of each derivative), then times both, interleaved (`nudged` is the state
+/// nudged from call to call, so that nothing is hoisted); returns (polhode, reduced) in ns.
+fn against_reduced<const N: usize>(
+    sc: &polhode::model::Spacecraft,
+    y: [f64; N],
+    nudged: usize,
+    reduced: impl Fn(&[f64; N], &mut [f64; N]),
+    repeats: usize,
+) -> (f64, f64) {
     use polhode::integrate::OdeSystem;
-    let s = scenario::load(
-        Path::new("scenarios/nutation-damper.yaml"),
-        &Overrides::default(),
-    )
-    .expect("scenario");
-    let sc = &s.spacecraft;
-    let mut y = sc.initial_state(&s.omega0, &s.attitude0);
-    // Off the rest point, so that every term is at work.
-    y[7] = 0.05;
-    y[8] = -0.2;
-    let y: [f64; 10] = y.try_into().expect("10 states");
-    let reduced = ReducedDamper::nutation_damper();
-    let (mut ours, mut theirs) = ([0.0; 10], [0.0; 10]);
+    let (mut ours, mut theirs) = ([0.0; N], [0.0; N]);
     sc.rhs(0.0, &y, &mut ours);
-    reduced.rhs(&y, &mut theirs);
-    for k in 0..10 {
+    reduced(&y, &mut theirs);
+    for k in 0..N {
         let scale = ours[k].abs().max(1e-9);
         assert!(
             (ours[k] - theirs[k]).abs() <= 1e-10 * scale,
@@ -308,28 +303,46 @@ fn bench_reduced_damper(repeats: usize) {
     let (mut best_reduced, mut best_ours) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..repeats {
         best_reduced = best_reduced.min(min_time(1, || {
-            let mut dy = [0.0; 10];
+            let mut dy = [0.0; N];
             for k in 0..calls {
                 let mut state = y;
-                state[8] += black_box(k as f64 * 1e-9);
-                reduced.rhs(black_box(&state), &mut dy);
+                state[nudged] += black_box(k as f64 * 1e-9);
+                reduced(black_box(&state), &mut dy);
                 black_box(&dy);
             }
         }));
         best_ours = best_ours.min(min_time(1, || {
-            let mut dy = [0.0; 10];
+            let mut dy = [0.0; N];
             for k in 0..calls {
                 let mut state = y;
-                state[8] += black_box(k as f64 * 1e-9);
+                state[nudged] += black_box(k as f64 * 1e-9);
                 sc.rhs(0.0, black_box(&state), &mut dy);
                 black_box(&dy);
             }
         }));
     }
-    let (ns_reduced, ns_ours) = (
-        best_reduced / calls as f64 * 1e9,
+    (
         best_ours / calls as f64 * 1e9,
-    );
+        best_reduced / calls as f64 * 1e9,
+    )
+}
+
+/// polhode's right-hand side of the nutation-damper scene against [`ReducedDamper`] at the
+/// same state (after checking that they agree).
+fn bench_reduced_damper(repeats: usize) {
+    let s = scenario::load(
+        Path::new("scenarios/nutation-damper.yaml"),
+        &Overrides::default(),
+    )
+    .expect("scenario");
+    let sc = &s.spacecraft;
+    let mut y = sc.initial_state(&s.omega0, &s.attitude0);
+    // Off the rest point, so that every term is at work.
+    y[7] = 0.05;
+    y[8] = -0.2;
+    let y: [f64; 10] = y.try_into().expect("10 states");
+    let reduced = ReducedDamper::nutation_damper();
+    let (ns_ours, ns_reduced) = against_reduced(sc, y, 8, |y, dy| reduced.rhs(y, dy), repeats);
     println!(
         "\nspring–mass damper (nutation-damper), one right-hand side against the hand-written \
          reduced form (one 3 × 3 solve):\n  polhode {ns_ours:.1} ns, reduced form {ns_reduced:.1} ns, \
@@ -435,7 +448,6 @@ impl ReducedPendulum {
 /// off its rest point), polhode's right-hand side against [`ReducedPendulum`] at the same
 /// state, after checking that they agree.
 fn bench_reduced_pendulum(repeats: usize) {
-    use polhode::integrate::OdeSystem;
     let yaml = "name: b\nbody: {mass: 800.0, principal: [900.0, 900.0, 250.0]}\n\
                 initial: {omega: [0.05, 0.0, 5.0]}\nduration: 1\neffectors:\n  \
                 - slosh_pendulum: {mass: 25.0, length: 0.3, pivot: [0.45, 0.0, 0.2], \
@@ -457,44 +469,7 @@ fn bench_reduced_pendulum(repeats: usize) {
         frame: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         damping: 100.0,
     };
-    let (mut ours, mut theirs) = ([0.0; 12], [0.0; 12]);
-    sc.rhs(0.0, &y, &mut ours);
-    reduced.rhs(&y, &mut theirs);
-    for k in 0..12 {
-        let scale = ours[k].abs().max(1e-9);
-        assert!(
-            (ours[k] - theirs[k]).abs() <= 1e-10 * scale,
-            "the reduced pendulum disagrees at state {k}: {} against {}",
-            theirs[k],
-            ours[k]
-        );
-    }
-    let calls = 100_000;
-    let (mut best_reduced, mut best_ours) = (f64::INFINITY, f64::INFINITY);
-    for _ in 0..repeats {
-        best_reduced = best_reduced.min(min_time(1, || {
-            let mut dy = [0.0; 12];
-            for k in 0..calls {
-                let mut state = y;
-                state[10] += black_box(k as f64 * 1e-9);
-                reduced.rhs(black_box(&state), &mut dy);
-                black_box(&dy);
-            }
-        }));
-        best_ours = best_ours.min(min_time(1, || {
-            let mut dy = [0.0; 12];
-            for k in 0..calls {
-                let mut state = y;
-                state[10] += black_box(k as f64 * 1e-9);
-                sc.rhs(0.0, black_box(&state), &mut dy);
-                black_box(&dy);
-            }
-        }));
-    }
-    let (ns_reduced, ns_ours) = (
-        best_reduced / calls as f64 * 1e9,
-        best_ours / calls as f64 * 1e9,
-    );
+    let (ns_ours, ns_reduced) = against_reduced(sc, y, 10, |y, dy| reduced.rhs(y, dy), repeats);
     println!(
         "\nslosh pendulum (one tank), one right-hand side against the hand-written reduced form \
          (a rank-one update):\n  polhode {ns_ours:.1} ns, reduced form {ns_reduced:.1} ns, \
