@@ -339,18 +339,29 @@ impl ParticleModel for SloshPendulum {
         let pull = (m_star * t.e.dot(&t.free)) * t.e + t.dashpot;
         let force = -omega.cross(&(hub_inertia * omega)) - t.r.cross(&pull);
         let arm = t.r.cross(&t.e);
-        let entry = |i: usize, j: usize| hub_inertia[(i, j)] + m_star * arm[i] * arm[j];
-        let Some(inverse) = spd_inverse3(
-            entry(0, 0),
-            entry(1, 0),
-            entry(2, 0),
-            entry(1, 1),
-            entry(2, 1),
-            entry(2, 2),
-        ) else {
-            return false;
+        let i = hub_inertia;
+        let diagonal = i[(1, 0)] == 0.0 && i[(2, 0)] == 0.0 && i[(2, 1)] == 0.0;
+        let w = if diagonal && i[(0, 0)] > 0.0 && i[(1, 1)] > 0.0 && i[(2, 2)] > 0.0 {
+            // Principal body axes: Sherman–Morrison on the diagonal,
+            // (I + m* t tᵀ)⁻¹ b = I⁻¹ b − m* I⁻¹t (tᵀ I⁻¹ b) / (1 + m* tᵀ I⁻¹ t).
+            let inv = Vector3::new(1.0 / i[(0, 0)], 1.0 / i[(1, 1)], 1.0 / i[(2, 2)]);
+            let ib = inv.component_mul(&force);
+            let it = inv.component_mul(&arm);
+            ib - (m_star * arm.dot(&ib) / (1.0 + m_star * arm.dot(&it))) * it
+        } else {
+            let entry = |r: usize, c: usize| i[(r, c)] + m_star * arm[r] * arm[c];
+            let Some(inverse) = spd_inverse3(
+                entry(0, 0),
+                entry(1, 0),
+                entry(2, 0),
+                entry(1, 1),
+                entry(2, 1),
+                entry(2, 2),
+            ) else {
+                return false;
+            };
+            inverse * force
         };
-        let w = inverse * force;
         let a = w.cross(&t.r) + t.free;
         for ((out, j), length) in u_dot.iter_mut().zip(&t.columns).zip(&t.lengths) {
             *out = (j.dot(&t.dashpot) / m_star - j.dot(&a)) / length;
