@@ -158,6 +158,7 @@ fn bench_effector_rhs(repeats: usize) {
         "explorer1",
         "flexible-boom",
         "explorer1-pydy-modal",
+        "spinning-stage-slosh",
     ] {
         let s = scenario::load(
             Path::new(&format!("scenarios/{file}.yaml")),
@@ -275,26 +276,21 @@ impl ReducedDamper {
     }
 }
 
-/// polhode's right-hand side of the nutation-damper scene against [`ReducedDamper`] at the
-/// same state (after checking that they agree).
-fn bench_reduced_damper(repeats: usize) {
+/// Checks that polhode's right-hand side of `sc` and a hand-written `reduced` one agree at
+/// `y` (to 1e-10 of each derivative), then times both, interleaved (`nudged` is the state
+/// nudged from call to call, so that nothing is hoisted); returns (polhode, reduced) in ns.
+fn against_reduced<const N: usize>(
+    sc: &polhode::model::Spacecraft,
+    y: [f64; N],
+    nudged: usize,
+    reduced: impl Fn(&[f64; N], &mut [f64; N]),
+    repeats: usize,
+) -> (f64, f64) {
     use polhode::integrate::OdeSystem;
-    let s = scenario::load(
-        Path::new("scenarios/nutation-damper.yaml"),
-        &Overrides::default(),
-    )
-    .expect("scenario");
-    let sc = &s.spacecraft;
-    let mut y = sc.initial_state(&s.omega0, &s.attitude0);
-    // Off the rest point, so that every term is at work.
-    y[7] = 0.05;
-    y[8] = -0.2;
-    let y: [f64; 10] = y.try_into().expect("10 states");
-    let reduced = ReducedDamper::nutation_damper();
-    let (mut ours, mut theirs) = ([0.0; 10], [0.0; 10]);
+    let (mut ours, mut theirs) = ([0.0; N], [0.0; N]);
     sc.rhs(0.0, &y, &mut ours);
-    reduced.rhs(&y, &mut theirs);
-    for k in 0..10 {
+    reduced(&y, &mut theirs);
+    for k in 0..N {
         let scale = ours[k].abs().max(1e-9);
         assert!(
             (ours[k] - theirs[k]).abs() <= 1e-10 * scale,
@@ -307,31 +303,176 @@ fn bench_reduced_damper(repeats: usize) {
     let (mut best_reduced, mut best_ours) = (f64::INFINITY, f64::INFINITY);
     for _ in 0..repeats {
         best_reduced = best_reduced.min(min_time(1, || {
-            let mut dy = [0.0; 10];
+            let mut dy = [0.0; N];
             for k in 0..calls {
                 let mut state = y;
-                state[8] += black_box(k as f64 * 1e-9);
-                reduced.rhs(black_box(&state), &mut dy);
+                state[nudged] += black_box(k as f64 * 1e-9);
+                reduced(black_box(&state), &mut dy);
                 black_box(&dy);
             }
         }));
         best_ours = best_ours.min(min_time(1, || {
-            let mut dy = [0.0; 10];
+            let mut dy = [0.0; N];
             for k in 0..calls {
                 let mut state = y;
-                state[8] += black_box(k as f64 * 1e-9);
+                state[nudged] += black_box(k as f64 * 1e-9);
                 sc.rhs(0.0, black_box(&state), &mut dy);
                 black_box(&dy);
             }
         }));
     }
-    let (ns_reduced, ns_ours) = (
-        best_reduced / calls as f64 * 1e9,
+    (
         best_ours / calls as f64 * 1e9,
-    );
+        best_reduced / calls as f64 * 1e9,
+    )
+}
+
+/// polhode's right-hand side of the nutation-damper scene against [`ReducedDamper`] at the
+/// same state (after checking that they agree).
+fn bench_reduced_damper(repeats: usize) {
+    let s = scenario::load(
+        Path::new("scenarios/nutation-damper.yaml"),
+        &Overrides::default(),
+    )
+    .expect("scenario");
+    let sc = &s.spacecraft;
+    let mut y = sc.initial_state(&s.omega0, &s.attitude0);
+    // Off the rest point, so that every term is at work.
+    y[7] = 0.05;
+    y[8] = -0.2;
+    let y: [f64; 10] = y.try_into().expect("10 states");
+    let reduced = ReducedDamper::nutation_damper();
+    let (ns_ours, ns_reduced) = against_reduced(sc, y, 8, |y, dy| reduced.rhs(y, dy), repeats);
     println!(
         "\nspring–mass damper (nutation-damper), one right-hand side against the hand-written \
          reduced form (one 3 × 3 solve):\n  polhode {ns_ours:.1} ns, reduced form {ns_reduced:.1} ns, \
+         ratio {:.2}",
+        ns_ours / ns_reduced
+    );
+}
+
+/// One slosh pendulum alone on a hub, reduced by hand: with the system's centre of mass fixed
+/// the bob moves as one of reduced mass m* = m M/(M + m) about a fixed hub centre, and since
+/// the rod's Jacobian columns span the plane ⊥ ê, eliminating (φ̈, θ̈) leaves a rank-one update
+/// of the hub's inertia (t = r × ê = d × ê, F = −c ṙ′ the dashpot's force, c_a the bob's
+/// acceleration at ω̇ = 0, u̇ = 0):
+///
+/// ```text
+/// (I + m* t tᵀ) ω̇ = −ω × Iω − r × (m* ê (ê·c_a) + F),
+/// q̈_k = (j_k·F/m* − j_k·(ω̇ × r + c_a)) / |j_k|²,
+/// ```
+///
+/// solved by Sherman–Morrison. States as polhode's: [ω, q, φ, θ, φ̇, θ̇, dissipated energy].
+struct ReducedPendulum {
+    hub_mass: f64,
+    inertia: [f64; 3],
+    mass: f64,
+    length: f64,
+    pivot: [f64; 3],
+    /// p̂₁, p̂₂, p̂₃ (body axes).
+    frame: [[f64; 3]; 3],
+    damping: f64,
+}
+
+impl ReducedPendulum {
+    #[inline(always)]
+    fn rhs(&self, y: &[f64; 12], dy: &mut [f64; 12]) {
+        fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        }
+        fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+            a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+        }
+        let w = [y[0], y[1], y[2]];
+        let (phi, theta, phi_dot, theta_dot) = (y[7], y[8], y[9], y[10]);
+        let [p1, p2, p3] = self.frame;
+        let (l, i) = (self.length, self.inertia);
+        let m_star = self.mass * self.hub_mass / (self.hub_mass + self.mass);
+        let (sp, cp) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        let radial = std::array::from_fn::<f64, 3, _>(|k| cp * p1[k] + sp * p2[k]);
+        let across = std::array::from_fn::<f64, 3, _>(|k| -sp * p1[k] + cp * p2[k]);
+        let e = std::array::from_fn::<f64, 3, _>(|k| ct * radial[k] - st * p3[k]);
+        let j_phi = std::array::from_fn::<f64, 3, _>(|k| l * ct * across[k]);
+        let j_theta = std::array::from_fn::<f64, 3, _>(|k| l * (-st * radial[k] - ct * p3[k]));
+        let r = std::array::from_fn::<f64, 3, _>(|k| self.pivot[k] + l * e[k]);
+        let v = std::array::from_fn::<f64, 3, _>(|k| j_phi[k] * phi_dot + j_theta[k] * theta_dot);
+        let w_r = cross(w, r);
+        let ww_r = cross(w, w_r);
+        let w_v = cross(w, v);
+        let c_a = std::array::from_fn::<f64, 3, _>(|k| {
+            ww_r[k] + 2.0 * w_v[k]
+                - l * (ct * phi_dot * phi_dot * radial[k]
+                    + 2.0 * st * phi_dot * theta_dot * across[k]
+                    + theta_dot * theta_dot * e[k])
+        });
+        let force = v.map(|x| -self.damping * x);
+        let ec = m_star * dot(e, c_a);
+        let pull = std::array::from_fn::<f64, 3, _>(|k| ec * e[k] + force[k]);
+        let iw = [i[0] * w[0], i[1] * w[1], i[2] * w[2]];
+        let gyro = cross(w, iw);
+        let r_pull = cross(r, pull);
+        let b = std::array::from_fn::<f64, 3, _>(|k| -gyro[k] - r_pull[k]);
+        let t = cross(self.pivot, e);
+        // Sherman–Morrison on the diagonal I.
+        let ib = [b[0] / i[0], b[1] / i[1], b[2] / i[2]];
+        let it = [t[0] / i[0], t[1] / i[1], t[2] / i[2]];
+        let k = m_star * dot(t, ib) / (1.0 + m_star * dot(t, it));
+        let w_dot = std::array::from_fn::<f64, 3, _>(|n| ib[n] - k * it[n]);
+        let wd_r = cross(w_dot, r);
+        let a = std::array::from_fn::<f64, 3, _>(|n| wd_r[n] + c_a[n]);
+        let accel = |j: [f64; 3], j2: f64| (dot(j, force) / m_star - dot(j, a)) / j2;
+        let (qw, qx, qy, qz) = (y[3], y[4], y[5], y[6]);
+        *dy = [
+            w_dot[0],
+            w_dot[1],
+            w_dot[2],
+            -0.5 * (qx * w[0] + qy * w[1] + qz * w[2]),
+            0.5 * (qw * w[0] + qy * w[2] - qz * w[1]),
+            0.5 * (qw * w[1] + qz * w[0] - qx * w[2]),
+            0.5 * (qw * w[2] + qx * w[1] - qy * w[0]),
+            phi_dot,
+            theta_dot,
+            accel(j_phi, l * l * ct * ct),
+            accel(j_theta, l * l),
+            self.damping * dot(v, v),
+        ];
+    }
+}
+
+/// One slosh pendulum on a prolate stage (one tank of scenarios/spinning-stage-slosh.yaml,
+/// off its rest point), polhode's right-hand side against [`ReducedPendulum`] at the same
+/// state, after checking that they agree.
+fn bench_reduced_pendulum(repeats: usize) {
+    let yaml = "name: b\nbody: {mass: 800.0, principal: [900.0, 900.0, 250.0]}\n\
+                initial: {omega: [0.05, 0.0, 5.0]}\nduration: 1\neffectors:\n  \
+                - slosh_pendulum: {mass: 25.0, length: 0.3, pivot: [0.45, 0.0, 0.2], \
+                rest_direction: [1, 0, 0], damping: 100.0, initial_angles: [0.2, -0.1], \
+                initial_rates: [0.3, 0.4]}\n";
+    let s = scenario::parse(Path::new("bench.yaml"), yaml.into(), &Overrides::default())
+        .expect("scenario");
+    let sc = &s.spacecraft;
+    let y: [f64; 12] = sc
+        .initial_state(&s.omega0, &s.attitude0)
+        .try_into()
+        .expect("12 states");
+    let reduced = ReducedPendulum {
+        hub_mass: 800.0,
+        inertia: [900.0, 900.0, 250.0],
+        mass: 25.0,
+        length: 0.3,
+        pivot: [0.45, 0.0, 0.2],
+        frame: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        damping: 100.0,
+    };
+    let (ns_ours, ns_reduced) = against_reduced(sc, y, 10, |y, dy| reduced.rhs(y, dy), repeats);
+    println!(
+        "\nslosh pendulum (one tank), one right-hand side against the hand-written reduced form \
+         (a rank-one update):\n  polhode {ns_ours:.1} ns, reduced form {ns_reduced:.1} ns, \
          ratio {:.2}",
         ns_ours / ns_reduced
     );
@@ -559,6 +700,7 @@ fn main() {
     if std::env::args().any(|a| a == "--effectors") {
         bench_effector_rhs(repeats);
         bench_reduced_damper(repeats);
+        bench_reduced_pendulum(repeats);
         return;
     }
     bench_environment_rhs(repeats);
@@ -570,6 +712,7 @@ fn main() {
     }
     bench_effector_rhs(repeats);
     bench_reduced_damper(repeats);
+    bench_reduced_pendulum(repeats);
     bench_wheel_rhs(repeats);
     bench_rk4_step(repeats);
     bench_logging(

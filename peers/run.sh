@@ -6,7 +6,7 @@
 # docs/peers.md. Needs cargo and python3 >= 3.9 (bsk 2.12.1 is one abi3 wheel,
 # cp39-abi3-manylinux_2_28_x86_64; used here with CPython 3.11).
 #
-#   peers/run.sh                 everything (about 4 min once built; the first build of
+#   peers/run.sh                 everything (about 5 min once built; the first build of
 #                                peers/rust-ode compiles polhode's dependencies again: ~9 min)
 #   peers/run.sh --no-basilisk   skip the Basilisk part
 #   peers/run.sh --report-only   regenerate docs/peers.md from peers/results/
@@ -46,8 +46,12 @@ if [[ $report_only == 0 ]]; then
   "$VENV/bin/python" "$PEERS/bench.py"
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
+    "$VENV/bin/python" "$PEERS/basilisk_slosh.py"
     "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
+  # slosh_pendulum along Basilisk's sphericalPendulum trajectories (results/basilisk_slosh.json).
+  echo "[run] polhode's slosh_pendulum against Basilisk's trajectories (tests/basilisk_slosh.rs)"
+  (cd "$ROOT" && cargo test --release --locked --quiet --test basilisk_slosh)
   # polhode's environmental torques at the states of results/basilisk_environment.json.
   echo "[run] polhode's environmental torques at Basilisk's states (tests/basilisk_environment.rs)"
   (cd "$ROOT" && POLHODE_PEER_OUT="$PEERS/results/basilisk_environment_polhode.json" \

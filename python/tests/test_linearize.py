@@ -9,9 +9,12 @@ import polhode
 from conftest import REPO
 
 # A spinner with a damper (modes about the steady spin), a gravity-gradient spacecraft in
-# orbit (about its LVLH equilibrium), a driven hub (the effectors' modes), a rigid body.
+# orbit (about its LVLH equilibrium), a driven hub (the effectors' modes), a rigid body, and
+# a spinning stage with slosh pendulums, given as pendulums and as tanks.
 SCENARIOS = [
     "scenarios/nutation-damper.yaml",
+    "scenarios/spinning-stage-slosh.yaml",
+    "scenarios/spinning-stage-tanks.yaml",
     "scenarios/gravity-gradient-smallsat.yaml",
     "scenarios/spin-up.yaml",
     "scenarios/tennis-racket.yaml",

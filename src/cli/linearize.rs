@@ -181,12 +181,25 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
             ),
             None => println!("  nutation: neutral, frequency {:.6e} rad/s", n.frequency),
         }
-        if let (Some(r), Some(tc)) = (n.energy_sink_rate, n.energy_sink_time_constant) {
+        if let (Some(r), Some(tc), Some(d)) = (
+            n.energy_sink_rate,
+            n.energy_sink_time_constant,
+            n.energy_sink_difference(),
+        ) {
             println!(
                 "  energy-sink estimate: {r:.9e} 1/s (time constant {tc:.6} s), {:+.1}% from \
                  the eigenvalue",
-                100.0 * (r - n.rate) / n.rate.abs().max(f64::MIN_POSITIVE)
+                100.0 * d
             );
+            if n.energy_sink_unreliable() {
+                println!(
+                    "  warning: the energy-sink estimate is {:+.0}% off the eigenvalue, past \
+                     the {:.0}% its assumptions allow (the effectors following the locked \
+                     body's nutation, away from resonance with it): use the eigenvalue",
+                    100.0 * d,
+                    100.0 * crate::linearize::ENERGY_SINK_DISAGREEMENT
+                );
+            }
         }
         if let Some(w) = &n.dual_spin_energy_sink {
             let tc = w

@@ -35,6 +35,7 @@ pub mod motor_wheel;
 pub mod particles;
 pub mod rayleigh;
 pub mod rod_lanes;
+pub mod slosh_analog;
 pub mod slosh_pendulum;
 pub mod solar_pressure;
 pub mod spring_mass;

@@ -1047,6 +1047,97 @@ mod tests {
         assert!(poisoned.force[0].is_nan() && kept.iter().all(|v| v.is_nan()));
     }
 
+    /// The slosh pendulum's coupling by hand (a point mass constrained along its rod only)
+    /// against the elimination from its particle sums, at random geometries and states.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // the lower triangle, index by index
+    fn slosh_pendulum_closed_form_coupling_equals_the_elimination_from_its_sums() {
+        use super::super::slosh_pendulum::{SloshPendulum, pendulum_frame};
+        use nalgebra::{Matrix6, Vector6};
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut uniform = |lo: f64, hi: f64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let start = HubCoupling {
+            mass: Matrix6::zeros(),
+            force: Vector6::zeros(),
+            translation: false,
+            tidal: None,
+        };
+        for _ in 0..50 {
+            let rest = Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+            let pendulum = SloshPendulum {
+                mass: uniform(0.5, 40.0),
+                length: uniform(0.05, 1.0),
+                pivot: Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)),
+                frame: pendulum_frame(rest.normalize()),
+                damping: uniform(0.0, 50.0),
+                fixed_mass: if uniform(0.0, 1.0) < 0.5 {
+                    0.0
+                } else {
+                    uniform(0.5, 40.0)
+                },
+                fixed_position: Vector3::new(
+                    uniform(-1.0, 1.0),
+                    uniform(-1.0, 1.0),
+                    uniform(-1.0, 1.0),
+                ),
+                amplitude_warning: None,
+            };
+            let e = ParticleEffector::new("p", pendulum, &[0.0; 2], &[0.0; 2]);
+            let x = [
+                uniform(-3.0, 3.0),
+                uniform(-1.4, 1.4),
+                uniform(-5.0, 5.0),
+                uniform(-5.0, 5.0),
+                0.0,
+            ];
+            let hub = HubState {
+                t: 0.0,
+                omega: Vector3::new(uniform(-6.0, 6.0), uniform(-6.0, 6.0), uniform(-6.0, 6.0)),
+                attitude: &[1.0, 0.0, 0.0, 0.0],
+            };
+            let (mut closed, mut reference) = (start.clone(), start.clone());
+            let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
+            e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
+            e.couple_from_sums::<2>(
+                &hub.omega,
+                &x[..2],
+                &x[2..4],
+                &mut reference,
+                &mut kept_reference,
+            );
+            let close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
+                let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                for (a, b) in by_hand.iter().zip(from_sums) {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "{what}: by hand {a:e}, from the sums {b:e} (scale {scale:e}) at {x:?}"
+                    );
+                }
+            };
+            let lower = |m: &Matrix6<f64>| {
+                let mut v = Vec::new();
+                for i in 0..6 {
+                    for j in 0..=i {
+                        v.push(m[(i, j)]);
+                    }
+                }
+                v
+            };
+            close(&lower(&closed.mass), &lower(&reference.mass), "mass");
+            close(closed.force.as_slice(), reference.force.as_slice(), "force");
+            close(&kept_closed[..7], &kept_reference[..7], "W, φ row");
+            close(&kept_closed[7..14], &kept_reference[7..14], "W, θ row");
+            assert_eq!(kept_closed[14..], kept_reference[14..], "L");
+            assert!(closed.translation);
+            closed_form_equals_particle_sums(&e, &x);
+        }
+    }
+
     #[test]
     fn spring_mass_closed_form_sums_equal_its_particle_sums() {
         use super::super::spring_mass::SpringMass;

@@ -84,6 +84,28 @@ pub struct Nutation {
     pub dual_spin_energy_sink: Option<DualSpinEnergySink>,
 }
 
+/// Relative disagreement between the energy-sink estimate and the eigenvalue past which the
+/// estimate's assumptions are taken not to hold (docs/effectors.md, "Linearisation of the
+/// coupled system"): a damper near resonance with the nutation, or one that does not follow
+/// the locked body's motion.
+pub const ENERGY_SINK_DISAGREEMENT: f64 = 0.25;
+
+impl Nutation {
+    /// (estimate − eigenvalue rate)/|eigenvalue rate| of the energy-sink estimate, when there
+    /// is one.
+    pub fn energy_sink_difference(&self) -> Option<f64> {
+        self.energy_sink_rate
+            .map(|r| (r - self.rate) / self.rate.abs().max(f64::MIN_POSITIVE))
+    }
+
+    /// Whether the energy-sink estimate is outside its assumptions here: it differs from the
+    /// eigenvalue by more than [`ENERGY_SINK_DISAGREEMENT`].
+    pub fn energy_sink_unreliable(&self) -> bool {
+        self.energy_sink_difference()
+            .is_some_and(|d| d.abs() > ENERGY_SINK_DISAGREEMENT)
+    }
+}
+
 /// The linearisation's result.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Linearization {

@@ -1,22 +1,34 @@
 //! `slosh_pendulum:` in the scenario file: a damped spherical pendulum, the mechanical analog
-//! of a tank's first lateral slosh mode ([`crate::effectors::slosh_pendulum`]).
+//! of a tank's first lateral slosh mode ([`crate::effectors::slosh_pendulum`]), given either
+//! as a pendulum or as a tank, from which the analog follows
+//! ([`crate::effectors::slosh_analog`], docs/slosh-analogs.md).
 //!
 //! ```yaml
-//! - slosh_pendulum:
-//!     mass: 20.0                 # kg, the sloshing mass
-//!     length: 0.3                # m, pivot to mass
-//!     pivot: [0.0, 0.0, 0.5]     # m, body axes, about the hub's centre of mass
-//!     rest_direction: [1, 0, 0]  # the rod's direction at φ = θ = 0
-//!     damping: 2.0               # N s/m, on the mass's velocity relative to the body
-//!     initial_angles: [0.1, 0.0] # rad, [φ, θ]
-//!     initial_rates: [0.0, 0.0]  # rad/s
+//! - slosh_pendulum:               # the pendulum itself
+//!     mass: 20.0                  # kg, the sloshing mass
+//!     length: 0.3                 # m, pivot to mass
+//!     pivot: [0.0, 0.0, 0.5]      # m, body axes, about the hub's centre of mass
+//!     rest_direction: [1, 0, 0]   # the rod's direction at φ = θ = 0
+//!     damping: 2.0                # N s/m, on the mass's velocity relative to the body
+//!     initial_angles: [0.1, 0.0]  # rad, [φ, θ]
+//!     initial_rates: [0.0, 0.0]   # rad/s
+//! - slosh_pendulum:               # or a tank in the spin's centrifugal field
+//!     tank:
+//!       shape: {sphere: {radius: 0.25}}   # or {cylinder: {radius: r, height: h}}
+//!       center: [0.5, 0.0, 0.2]           # m, body axes
+//!       fill: 0.5                         # by volume
+//!       liquid: {density: 1004.0, kinematic_viscosity: 9.0e-7, surface_tension: 0.066}
 //! ```
 
 use super::{Check, Context, ScenarioError};
 use crate::effectors::ParticleEffector;
-use crate::effectors::slosh_pendulum::{
-    SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame,
+use crate::effectors::slosh_analog::{
+    Liquid, SPIN_NONUNIFORMITY_MAX, SloshAnalog, SloshWarning, Tank, slosh_analog, spin_field,
 };
+use crate::effectors::slosh_pendulum::{
+    SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame, pendulum_frame_with_pole,
+};
+use nalgebra::Vector3;
 use serde::Deserialize;
 use serde_saphyr::Spanned;
 
@@ -28,16 +40,29 @@ pub struct SloshPendulumSpec {
     #[serde(default)]
     pub name: Option<String>,
     /// The sloshing mass (kg).
-    pub mass: Spanned<f64>,
+    #[serde(default)]
+    pub mass: Option<Spanned<f64>>,
     /// Rod length, pivot to mass (m).
-    pub length: Spanned<f64>,
+    #[serde(default)]
+    pub length: Option<Spanned<f64>>,
     /// Pivot (m, body axes, about the hub's centre of mass, or the whole spacecraft's with
     /// `body.composite`); checked to be on or in `body.shape` when one is given.
-    pub pivot: Spanned<[f64; 3]>,
+    #[serde(default)]
+    pub pivot: Option<Spanned<[f64; 3]>>,
     /// The rod's direction at zero angles (body axes; normalised).
-    pub rest_direction: Spanned<[f64; 3]>,
+    #[serde(default)]
+    pub rest_direction: Option<Spanned<[f64; 3]>>,
     /// Dashpot on the mass's velocity relative to the body (N s/m).
-    pub damping: Spanned<f64>,
+    #[serde(default)]
+    pub damping: Option<Spanned<f64>>,
+    /// A tank, instead of the five keys above.
+    #[serde(default)]
+    pub tank: Option<Spanned<TankSpec>>,
+    /// p̂₃, the direction along which the angles are singular (body axes, ⊥ the rest
+    /// direction): choose one the rod will not reach. Default: from the rest direction alone
+    /// (docs/effectors.md), or for a tank the direction tangential to the spin.
+    #[serde(default)]
+    pub pole: Option<Spanned<[f64; 3]>>,
     /// Initial `[φ, θ]` (rad).
     #[serde(default)]
     pub initial_angles: Option<Spanned<[f64; 2]>>,
@@ -45,6 +70,57 @@ pub struct SloshPendulumSpec {
     #[serde(default)]
     pub initial_rates: Option<Spanned<[f64; 2]>>,
 }
+
+/// `tank:` — a tank whose first lateral slosh mode the pendulum stands for.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TankSpec {
+    /// `{sphere: {radius}}` or `{cylinder: {radius, height}}` (m); a cylinder stands with its
+    /// axis along the field, radially outward from the spin axis.
+    pub shape: Spanned<TankShapeSpec>,
+    /// The tank's geometric centre (m, body axes).
+    pub center: Spanned<[f64; 3]>,
+    /// Fill fraction by volume.
+    pub fill: Spanned<f64>,
+    /// The propellant.
+    pub liquid: Spanned<LiquidSpec>,
+}
+
+/// The tank's shape.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+pub enum TankShapeSpec {
+    /// A sphere.
+    Sphere {
+        /// Inner radius (m).
+        radius: f64,
+    },
+    /// An upright cylinder with flat ends.
+    Cylinder {
+        /// Inner radius (m).
+        radius: f64,
+        /// Inner height between the ends (m).
+        height: f64,
+    },
+}
+
+/// `liquid:`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LiquidSpec {
+    /// Density (kg/m³).
+    pub density: f64,
+    /// Kinematic viscosity (m²/s).
+    pub kinematic_viscosity: f64,
+    /// Surface tension against the ullage gas (N/m).
+    pub surface_tension: f64,
+}
+
+/// Field non-uniformity across a tank (Ω² R/|g| = R/r_T in a pure spin) past which a tank is
+/// refused: the field then varies by half its value between the centre and the wall, and a
+/// uniform-field analog says nothing reliable (docs/slosh-analogs.md). Between
+/// [`SPIN_NONUNIFORMITY_MAX`] and this, the run is warned.
+const NONUNIFORMITY_REFUSE: f64 = 0.5;
 
 /// Validates a `slosh_pendulum:` entry and builds it.
 pub(super) fn build(
@@ -65,12 +141,54 @@ pub(super) fn build(
             ),
         )),
     };
-    let model = SloshPendulum {
-        mass: ck.positive(&spec.mass, "mass", "kg")?,
-        length: ck.positive(&spec.length, "length", "m")?,
-        pivot: ck.on_body(&spec.pivot, "pivot", "the pendulum's pivot", cx)? + cx.shift,
-        frame: pendulum_frame(ck.unit(&spec.rest_direction, "rest_direction")?),
-        damping: ck.non_negative(&spec.damping, "damping", "N s/m")?,
+    let model = match &spec.tank {
+        Some(tank) => from_tank(ck, cx, spec, tank)?,
+        None => {
+            let missing = |key: &str, what: &str| {
+                ScenarioError::at(
+                    cx.path,
+                    None,
+                    ck.prefix.clone(),
+                    format!(
+                        "missing field `{key}` ({what}): give the pendulum's `mass`, `length`, \
+                         `pivot`, `rest_direction` and `damping`, or a `tank:` to derive them \
+                         from"
+                    ),
+                )
+            };
+            let mass = spec.mass.as_ref().ok_or_else(|| missing("mass", "kg"))?;
+            let length = spec.length.as_ref().ok_or_else(|| missing("length", "m"))?;
+            let pivot = spec
+                .pivot
+                .as_ref()
+                .ok_or_else(|| missing("pivot", "m, body axes"))?;
+            let rest = spec
+                .rest_direction
+                .as_ref()
+                .ok_or_else(|| missing("rest_direction", "body axes"))?;
+            let damping = spec
+                .damping
+                .as_ref()
+                .ok_or_else(|| missing("damping", "N s/m"))?;
+            let p1 = ck.unit(rest, "rest_direction")?;
+            let frame = match &spec.pole {
+                Some(pole) => pendulum_frame_with_pole(
+                    p1,
+                    ck.perpendicular(pole, "pole", &p1, "rest_direction")?,
+                ),
+                None => pendulum_frame(p1),
+            };
+            SloshPendulum {
+                mass: ck.positive(mass, "mass", "kg")?,
+                length: ck.positive(length, "length", "m")?,
+                pivot: ck.on_body(pivot, "pivot", "the pendulum's pivot", cx)? + cx.shift,
+                frame,
+                damping: ck.non_negative(damping, "damping", "N s/m")?,
+                fixed_mass: 0.0,
+                fixed_position: Vector3::zeros(),
+                amplitude_warning: None,
+            }
+        }
     };
     let q0 = pair(&spec.initial_angles, "initial_angles", "rad")?;
     let u0 = pair(&spec.initial_rates, "initial_rates", "rad/s")?;
@@ -92,4 +210,148 @@ pub(super) fn build(
         ));
     }
     Ok(ParticleEffector::new(name, model, &q0, &u0))
+}
+
+/// The pendulum of a tank's first lateral slosh mode in the centrifugal field of the initial
+/// spin: the field at the tank's centre is Ω² r_T, radially outward from the spin axis (through
+/// the hub's centre of mass), and the analog's axis is that direction.
+fn from_tank(
+    ck: &Check,
+    cx: &Context,
+    spec: &SloshPendulumSpec,
+    tank: &Spanned<TankSpec>,
+) -> Result<SloshPendulum, ScenarioError> {
+    for (given, key) in [
+        (spec.mass.is_some(), "mass"),
+        (spec.length.is_some(), "length"),
+        (spec.pivot.is_some(), "pivot"),
+        (spec.rest_direction.is_some(), "rest_direction"),
+        (spec.damping.is_some(), "damping"),
+    ] {
+        if given {
+            return Err(ck.err(
+                tank,
+                "tank",
+                format!(
+                    "`{key}` and `tank` are both given: with a tank, the pendulum's mass, \
+                     length, pivot, rest direction and damping follow from it; remove `{key}`, \
+                     or the tank"
+                ),
+            ));
+        }
+    }
+    let t = &tank.value;
+    let shape = match t.shape.value {
+        TankShapeSpec::Sphere { radius } => Tank::Sphere { radius },
+        TankShapeSpec::Cylinder { radius, height } => Tank::Cylinder { radius, height },
+    };
+    let liquid = Liquid {
+        density: t.liquid.value.density,
+        kinematic_viscosity: t.liquid.value.kinematic_viscosity,
+        surface_tension: t.liquid.value.surface_tension,
+    };
+    let center = ck.on_body(&t.center, "tank.center", "the tank's centre", cx)? + cx.shift;
+    let axis = cx.spin_axis;
+    let spin = cx.omega0.dot(&axis);
+    let outward = center - center.dot(&axis) * axis;
+    let distance = outward.norm();
+    let radius = shape.radius();
+    let field = spin_field(spin, distance, 0.0, radius).map_err(|e| {
+        ck.err(
+            &t.center,
+            "tank.center",
+            format!(
+                "{e}: the tank's centre is {distance:.4} m from the spin axis and the initial \
+                 spin is {spin:.6} rad/s; the analog needs the centrifugal field of a spin \
+                 about an axis the tank is off"
+            ),
+        )
+    })?;
+    if field.nonuniformity > NONUNIFORMITY_REFUSE {
+        return Err(ck.err(
+            &t.center,
+            "tank.center",
+            format!(
+                "the centrifugal field changes by {:.0}% across the tank (radius {radius} m at \
+                 {distance:.4} m from the spin axis); the pendulum analog assumes a uniform \
+                 field, and past {:.0}% it no longer describes the liquid \
+                 (docs/slosh-analogs.md): a tank on or near the spin axis needs another model",
+                100.0 * field.nonuniformity,
+                100.0 * NONUNIFORMITY_REFUSE
+            ),
+        ));
+    }
+    if field.nonuniformity > SPIN_NONUNIFORMITY_MAX {
+        cx.notes.borrow_mut().push(ck.err(
+            &t.center,
+            "tank.center",
+            format!(
+                "slosh analog: the centrifugal field changes by {:.0}% across the tank (R/r_T); \
+                 the uniform-field analog is accurate to a few percent up to {:.0}% \
+                 (docs/slosh-analogs.md), so expect its frequency and damping to be off by \
+                 more here",
+                100.0 * field.nonuniformity,
+                100.0 * SPIN_NONUNIFORMITY_MAX
+            ),
+        ));
+    }
+    let analog: SloshAnalog = slosh_analog(&shape, t.fill.value, &liquid, field.acceleration)
+        .map_err(|e| {
+            let (at, key) = match e {
+                crate::effectors::slosh_analog::SloshError::FillOutOfRange { .. } => {
+                    (super::loc(&t.fill), "tank.fill")
+                }
+                _ => (super::loc(tank), "tank"),
+            };
+            ScenarioError::at(cx.path, at, format!("{}.{key}", ck.prefix), e.to_string())
+        })?;
+    let down = outward / distance;
+    for w in &analog.warnings {
+        let text = match w {
+            SloshWarning::BondMarginal { bond } => format!(
+                "Bond number {bond:.1}: surface tension raises the slosh frequency by a few \
+                 percent, which the gravity analog leaves out"
+            ),
+            SloshWarning::ShallowLiquid { depth_ratio } => format!(
+                "shallow liquid (h/R = {depth_ratio:.3}): the analog's damping correlation is \
+                 least certain here"
+            ),
+        };
+        cx.notes
+            .borrow_mut()
+            .push(ck.err(tank, "tank", format!("slosh analog: {text}")));
+    }
+    let coriolis = analog.coriolis_ratio(spin);
+    if coriolis > 1.0 {
+        cx.notes.borrow_mut().push(ck.err(
+            tank,
+            "tank",
+            format!(
+                "slosh analog: the Coriolis acceleration on the liquid is {coriolis:.2} times \
+                 its restoring one (2Ω/ω₁); the uniform-field pendulum leaves the liquid's own \
+                 Coriolis coupling out"
+            ),
+        ));
+    }
+    // Heights are along "up", against the field. The pole is tangential to the spin unless
+    // given: a spin that moves toward another body axis (a flat spin) swings the rod in the
+    // plane of the spin axis and the tank, away from it.
+    let up = -down;
+    let frame = match &spec.pole {
+        Some(pole) => pendulum_frame_with_pole(
+            down,
+            ck.perpendicular(pole, "pole", &down, "the tank's field direction")?,
+        ),
+        None => pendulum_frame_with_pole(down, axis.cross(&down).normalize()),
+    };
+    Ok(SloshPendulum {
+        mass: analog.slosh_mass,
+        length: analog.pendulum_length,
+        pivot: center + analog.pivot_height * up,
+        frame,
+        damping: analog.dashpot,
+        fixed_mass: analog.fixed_mass,
+        fixed_position: center + analog.fixed_mass_height * up,
+        amplitude_warning: Some(analog.max_pendulum_angle(0.1, radius)),
+    })
 }
