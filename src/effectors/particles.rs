@@ -986,47 +986,8 @@ mod tests {
             let [flap, lag, flap_rate, lag_rate] = flap_lag_state(k);
             let x = [flap, lag, flap_rate, lag_rate, 0.0];
             // The hub's rate up to 80 rad/s.
-            let hub = HubState {
-                t: 0.0,
-                omega: Vector3::new(0.4 * a.cos(), -1.3, 3.2 * a),
-                attitude: &[1.0, 0.0, 0.0, 0.0],
-            };
-            let (mut closed, mut reference) = (start.clone(), start.clone());
-            let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
-            e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
-            e.couple_from_sums::<2>(
-                &hub.omega,
-                &x[..2],
-                &x[2..4],
-                &mut reference,
-                &mut kept_reference,
-            );
-            let mut close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
-                let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                for (a, b) in by_hand.iter().zip(from_sums) {
-                    let error = (a - b).abs() / scale;
-                    worst = worst.max(error);
-                    assert!(
-                        error <= 1e-13,
-                        "{what}: by hand {a:e}, from the sums {b:e} (scale {scale:e}) at {x:?}"
-                    );
-                }
-            };
-            let lower = |m: &Matrix6<f64>| {
-                let mut v = Vec::new();
-                for i in 0..6 {
-                    for j in 0..=i {
-                        v.push(m[(i, j)]);
-                    }
-                }
-                v
-            };
-            close(&lower(&closed.mass), &lower(&reference.mass), "mass");
-            close(closed.force.as_slice(), reference.force.as_slice(), "force");
-            close(&kept_closed[..7], &kept_reference[..7], "W, flap row");
-            close(&kept_closed[7..14], &kept_reference[7..14], "W, lag row");
-            assert_eq!(kept_closed[14..], kept_reference[14..], "L");
-            assert!(closed.translation);
+            let omega = Vector3::new(0.4 * a.cos(), -1.3, 3.2 * a);
+            worst = worst.max(coupling_by_hand_equals_the_sums(&e, &x, omega, 1e-13));
         }
         eprintln!("largest difference, relative to each quantity's scale: {worst:e}");
         let e = rod(geometries[0]);
@@ -1047,25 +1008,80 @@ mod tests {
         assert!(poisoned.force[0].is_nan() && kept.iter().all(|v| v.is_nan()));
     }
 
+    /// A two-coordinate model's coupling by hand (`couple_sized`, which takes its closed form)
+    /// against the elimination from its sums (`couple_from_sums`) at state `x` and hub
+    /// rate `omega`: hub mass and force, both rows of W and L, each within `tolerance` of its
+    /// largest entry. Returns the largest relative difference.
+    #[allow(clippy::needless_range_loop)] // the lower triangle, index by index
+    fn coupling_by_hand_equals_the_sums<P: ParticleModel + 'static>(
+        e: &ParticleEffector<P>,
+        x: &[f64; 5],
+        omega: Vector3<f64>,
+        tolerance: f64,
+    ) -> f64 {
+        use nalgebra::{Matrix6, Vector6};
+        let start = HubCoupling {
+            mass: Matrix6::zeros(),
+            force: Vector6::zeros(),
+            translation: false,
+            tidal: None,
+        };
+        let hub = HubState {
+            t: 0.0,
+            omega,
+            attitude: &[1.0, 0.0, 0.0, 0.0],
+        };
+        let (mut closed, mut reference) = (start.clone(), start);
+        let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
+        e.couple_sized::<2>(&hub, x, &mut closed, &mut kept_closed);
+        e.couple_from_sums::<2>(
+            &omega,
+            &x[..2],
+            &x[2..4],
+            &mut reference,
+            &mut kept_reference,
+        );
+        let mut worst = 0.0f64;
+        let mut close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
+            let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (a, b) in by_hand.iter().zip(from_sums) {
+                let error = (a - b).abs() / scale;
+                worst = worst.max(error);
+                assert!(
+                    error <= tolerance,
+                    "{what}: by hand {a:e}, from the sums {b:e} (scale {scale:e}) at {x:?}"
+                );
+            }
+        };
+        let lower = |m: &Matrix6<f64>| {
+            let mut v = Vec::new();
+            for i in 0..6 {
+                for j in 0..=i {
+                    v.push(m[(i, j)]);
+                }
+            }
+            v
+        };
+        close(&lower(&closed.mass), &lower(&reference.mass), "mass");
+        close(closed.force.as_slice(), reference.force.as_slice(), "force");
+        close(&kept_closed[..7], &kept_reference[..7], "W, first row");
+        close(&kept_closed[7..14], &kept_reference[7..14], "W, second row");
+        assert_eq!(kept_closed[14..], kept_reference[14..], "L");
+        assert!(closed.translation);
+        worst
+    }
+
     /// The slosh pendulum's coupling by hand (a point mass constrained along its rod only)
     /// against the elimination from its particle sums, at random geometries and states.
     #[test]
-    #[allow(clippy::needless_range_loop)] // the lower triangle, index by index
     fn slosh_pendulum_closed_form_coupling_equals_the_elimination_from_its_sums() {
         use super::super::slosh_pendulum::{SloshPendulum, pendulum_frame};
-        use nalgebra::{Matrix6, Vector6};
         let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
         let mut uniform = |lo: f64, hi: f64| {
             seed ^= seed << 13;
             seed ^= seed >> 7;
             seed ^= seed << 17;
             lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let start = HubCoupling {
-            mass: Matrix6::zeros(),
-            force: Vector6::zeros(),
-            translation: false,
-            tidal: None,
         };
         for _ in 0..50 {
             let rest = Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
@@ -1095,45 +1111,8 @@ mod tests {
                 uniform(-5.0, 5.0),
                 0.0,
             ];
-            let hub = HubState {
-                t: 0.0,
-                omega: Vector3::new(uniform(-6.0, 6.0), uniform(-6.0, 6.0), uniform(-6.0, 6.0)),
-                attitude: &[1.0, 0.0, 0.0, 0.0],
-            };
-            let (mut closed, mut reference) = (start.clone(), start.clone());
-            let (mut kept_closed, mut kept_reference) = ([0.0; 17], [0.0; 17]);
-            e.couple_sized::<2>(&hub, &x, &mut closed, &mut kept_closed);
-            e.couple_from_sums::<2>(
-                &hub.omega,
-                &x[..2],
-                &x[2..4],
-                &mut reference,
-                &mut kept_reference,
-            );
-            let close = |by_hand: &[f64], from_sums: &[f64], what: &str| {
-                let scale = from_sums.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                for (a, b) in by_hand.iter().zip(from_sums) {
-                    assert!(
-                        (a - b).abs() <= 1e-12 * scale,
-                        "{what}: by hand {a:e}, from the sums {b:e} (scale {scale:e}) at {x:?}"
-                    );
-                }
-            };
-            let lower = |m: &Matrix6<f64>| {
-                let mut v = Vec::new();
-                for i in 0..6 {
-                    for j in 0..=i {
-                        v.push(m[(i, j)]);
-                    }
-                }
-                v
-            };
-            close(&lower(&closed.mass), &lower(&reference.mass), "mass");
-            close(closed.force.as_slice(), reference.force.as_slice(), "force");
-            close(&kept_closed[..7], &kept_reference[..7], "W, φ row");
-            close(&kept_closed[7..14], &kept_reference[7..14], "W, θ row");
-            assert_eq!(kept_closed[14..], kept_reference[14..], "L");
-            assert!(closed.translation);
+            let omega = Vector3::new(uniform(-6.0, 6.0), uniform(-6.0, 6.0), uniform(-6.0, 6.0));
+            coupling_by_hand_equals_the_sums(&e, &x, omega, 1e-12);
             closed_form_equals_particle_sums(&e, &x);
         }
     }

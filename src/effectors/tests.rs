@@ -3,7 +3,7 @@
 use super::beam::{BeamProperties, beam_modes};
 use super::*;
 use crate::integrate::{Dopri5, OdeSystem, Stepper, Tolerances};
-use crate::model::{RigidBody, Spacecraft};
+use crate::model::{Effector, RigidBody, Spacecraft};
 use approx::assert_relative_eq;
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 
@@ -152,74 +152,124 @@ fn one_damper_depends_on_the_masses_only_through_the_reduced_mass() {
     assert!((a[7] - b[7]).abs() < 1e-9 && (a[8] - b[8]).abs() < 1e-9);
 }
 
+/// Uniform numbers in [lo, hi) from a xorshift generator seeded with `seed`: the random
+/// scenes of the lone-effector tests.
+fn uniform_from(mut seed: u64) -> impl FnMut(f64, f64) -> f64 {
+    move |lo: f64, hi: f64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A hub of random principal moments (30–50 kg m²) and mass (20–500 kg) carrying `effector`,
+/// and a spinning wheel damper beside it when `wheel`.
+fn random_hub_with(
+    uniform: &mut impl FnMut(f64, f64) -> f64,
+    effector: impl FnOnce(&mut dyn FnMut(f64, f64) -> f64) -> Box<dyn Effector>,
+    wheel: bool,
+) -> Spacecraft {
+    let hub = RigidBody::from_principal([
+        uniform(30.0, 50.0),
+        uniform(30.0, 50.0),
+        uniform(30.0, 50.0),
+    ])
+    .unwrap();
+    let mut sc = Spacecraft::new(hub, Vector3::z());
+    sc.hub_mass = Some(uniform(20.0, 500.0));
+    sc.add_effector(effector(uniform)).unwrap();
+    if wheel {
+        sc.add_effector(Box::new(WheelDamper {
+            name: "wheel".into(),
+            inertia: 0.3,
+            axis: Vector3::new(0.0, 0.6, 0.8),
+            damping: 0.2,
+            initial_rate: 1.5,
+            position: Vector3::zeros(),
+            max_speed: None,
+        }))
+        .unwrap();
+    }
+    sc
+}
+
+/// A random tumbling state of `sc` with the first effector's states set by `set`.
+fn random_state(
+    sc: &Spacecraft,
+    uniform: &mut impl FnMut(f64, f64) -> f64,
+    set: &[f64],
+) -> Vec<f64> {
+    let mut y = sc.initial_state(
+        &Vector3::new(uniform(-3.0, 3.0), uniform(-3.0, 3.0), uniform(-3.0, 3.0)),
+        &UnitQuaternion::from_euler_angles(uniform(-3.0, 3.0), uniform(-1.5, 1.5), 0.4),
+    );
+    let x = sc.effector_offset(0);
+    for (k, range) in set.iter().enumerate() {
+        y[x + k] = uniform(-range, *range);
+    }
+    y
+}
+
+/// The right-hand side of `sc` at `y` by the lone effector's own path and by the general one
+/// (coupling, 6 × 6 hub solve), which must agree within `tolerance` of the largest
+/// derivative; returns both.
+fn lone_against_general(
+    sc: &mut Spacecraft,
+    y: &[f64],
+    tolerance: f64,
+    case: usize,
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut reduced, mut general) = (vec![0.0; y.len()], vec![0.0; y.len()]);
+    sc.rhs(0.0, y, &mut reduced);
+    sc.couple_alone_effector(false);
+    sc.rhs(0.0, y, &mut general);
+    let scale = general.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    for (k, (a, b)) in reduced.iter().zip(&general).enumerate() {
+        assert!(
+            (a - b).abs() <= tolerance * scale,
+            "case {case}, state {k}: {a:e} by hand, {b:e} in general (scale {scale:e})"
+        );
+    }
+    (reduced, general)
+}
+
 /// A lone spring–mass eliminates the hub's translation itself (the two-body reduction,
 /// `SpringMass::couple_alone_closed_form`); the general path (its particle sums, the 6 × 6
 /// hub solve) must give the same right-hand side to rounding, with or without a wheel beside
 /// it, at states far from rest.
 #[test]
 fn a_lone_damper_reduced_by_hand_equals_the_general_path() {
-    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-    let mut uniform = |lo: f64, hi: f64| {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d_u64);
     for case in 0..24 {
-        let hub = RigidBody::from_principal([
-            uniform(30.0, 50.0),
-            uniform(30.0, 50.0),
-            uniform(30.0, 50.0),
-        ])
-        .unwrap();
-        let mut sc = Spacecraft::new(hub, Vector3::z());
-        sc.hub_mass = Some(uniform(20.0, 500.0));
-        let mut direction =
-            Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
-        // The last cases keep a direction that is not a unit vector: the general path then.
-        if case < 20 {
-            direction = direction.normalize();
-        }
-        let smd = SpringMass {
-            mass: uniform(0.5, 30.0),
-            position: Vector3::new(uniform(-2.0, 2.0), uniform(-2.0, 2.0), uniform(-2.0, 2.0)),
-            direction,
-            stiffness: uniform(0.0, 100.0),
-            damping: uniform(0.0, 50.0),
-            travel: None,
-        };
-        sc.add_effector(Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0])))
-            .unwrap();
-        if case % 2 == 1 {
-            sc.add_effector(Box::new(WheelDamper {
-                name: "wheel".into(),
-                inertia: 0.3,
-                axis: Vector3::new(0.0, 0.6, 0.8),
-                damping: 0.2,
-                initial_rate: 1.5,
-                position: Vector3::zeros(),
-                max_speed: None,
-            }))
-            .unwrap();
-        }
-        let mut y = sc.initial_state(
-            &Vector3::new(uniform(-3.0, 3.0), uniform(-3.0, 3.0), uniform(-3.0, 3.0)),
-            &UnitQuaternion::from_euler_angles(uniform(-3.0, 3.0), uniform(-1.5, 1.5), 0.4),
+        let mut sc = random_hub_with(
+            &mut uniform,
+            |uniform| {
+                let mut direction =
+                    Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+                // The last cases keep a direction that is not a unit vector: the general path
+                // then.
+                if case < 20 {
+                    direction = direction.normalize();
+                }
+                let smd = SpringMass {
+                    mass: uniform(0.5, 30.0),
+                    position: Vector3::new(
+                        uniform(-2.0, 2.0),
+                        uniform(-2.0, 2.0),
+                        uniform(-2.0, 2.0),
+                    ),
+                    direction,
+                    stiffness: uniform(0.0, 100.0),
+                    damping: uniform(0.0, 50.0),
+                    travel: None,
+                };
+                Box::new(ParticleEffector::new("d", smd, &[0.0], &[0.0]))
+            },
+            case % 2 == 1,
         );
-        let x = sc.effector_offset(0);
-        y[x] = uniform(-0.5, 0.5);
-        y[x + 1] = uniform(-2.0, 2.0);
-        let (mut reduced, mut general) = (vec![0.0; y.len()], vec![0.0; y.len()]);
-        sc.rhs(0.0, &y, &mut reduced);
-        sc.couple_alone_effector(false);
-        sc.rhs(0.0, &y, &mut general);
-        let scale = general.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-        for (k, (a, b)) in reduced.iter().zip(&general).enumerate() {
-            assert!(
-                (a - b).abs() <= 1e-13 * scale,
-                "case {case}, state {k}: {a:e} by hand, {b:e} in general (scale {scale:e})"
-            );
-        }
+        let y = random_state(&sc, &mut uniform, &[0.5, 2.0]);
+        let (reduced, general) = lone_against_general(&mut sc, &y, 1e-13, case);
         if case >= 20 {
             assert_eq!(reduced, general, "case {case}: a non-unit direction");
         }
@@ -233,68 +283,28 @@ fn a_lone_damper_reduced_by_hand_equals_the_general_path() {
 #[test]
 fn a_lone_slosh_pendulum_reduced_by_hand_equals_the_general_path() {
     use super::slosh_pendulum::{SloshPendulum, pendulum_frame};
-    let mut seed = 0x1234_5678_9abc_def1_u64;
-    let mut uniform = |lo: f64, hi: f64| {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        lo + (hi - lo) * (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x1234_5678_9abc_def1_u64);
     for case in 0..24 {
-        let hub = RigidBody::from_principal([
-            uniform(30.0, 50.0),
-            uniform(30.0, 50.0),
-            uniform(30.0, 50.0),
-        ])
-        .unwrap();
-        let mut sc = Spacecraft::new(hub, Vector3::z());
-        sc.hub_mass = Some(uniform(20.0, 500.0));
-        let rest = Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
-        let pendulum = SloshPendulum {
-            mass: uniform(0.5, 30.0),
-            length: uniform(0.05, 1.0),
-            pivot: Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)),
-            frame: pendulum_frame(rest.normalize()),
-            damping: uniform(0.0, 50.0),
-            fixed_mass: 0.0,
-            fixed_position: Vector3::zeros(),
-            amplitude_warning: None,
-        };
-        sc.add_effector(Box::new(ParticleEffector::new(
-            "p", pendulum, &[0.0; 2], &[0.0; 2],
-        )))
-        .unwrap();
-        if case % 2 == 1 {
-            sc.add_effector(Box::new(WheelDamper {
-                name: "wheel".into(),
-                inertia: 0.3,
-                axis: Vector3::new(0.0, 0.6, 0.8),
-                damping: 0.2,
-                initial_rate: 1.5,
-                position: Vector3::zeros(),
-                max_speed: None,
-            }))
-            .unwrap();
-        }
-        let mut y = sc.initial_state(
-            &Vector3::new(uniform(-3.0, 3.0), uniform(-3.0, 3.0), uniform(-3.0, 3.0)),
-            &UnitQuaternion::from_euler_angles(uniform(-3.0, 3.0), uniform(-1.5, 1.5), 0.4),
+        let mut sc = random_hub_with(
+            &mut uniform,
+            |uniform| {
+                let rest = Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0));
+                let pendulum = SloshPendulum {
+                    mass: uniform(0.5, 30.0),
+                    length: uniform(0.05, 1.0),
+                    pivot: Vector3::new(uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)),
+                    frame: pendulum_frame(rest.normalize()),
+                    damping: uniform(0.0, 50.0),
+                    fixed_mass: 0.0,
+                    fixed_position: Vector3::zeros(),
+                    amplitude_warning: None,
+                };
+                Box::new(ParticleEffector::new("p", pendulum, &[0.0; 2], &[0.0; 2]))
+            },
+            case % 2 == 1,
         );
-        let x = sc.effector_offset(0);
-        for (k, range) in [3.0, 1.4, 4.0, 4.0].into_iter().enumerate() {
-            y[x + k] = uniform(-range, range);
-        }
-        let (mut reduced, mut general) = (vec![0.0; y.len()], vec![0.0; y.len()]);
-        sc.rhs(0.0, &y, &mut reduced);
-        sc.couple_alone_effector(false);
-        sc.rhs(0.0, &y, &mut general);
-        let scale = general.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-        for (k, (a, b)) in reduced.iter().zip(&general).enumerate() {
-            assert!(
-                (a - b).abs() <= 1e-12 * scale,
-                "case {case}, state {k}: {a:e} by hand, {b:e} in general (scale {scale:e})"
-            );
-        }
+        let y = random_state(&sc, &mut uniform, &[3.0, 1.4, 4.0, 4.0]);
+        lone_against_general(&mut sc, &y, 1e-12, case);
     }
 }
 
