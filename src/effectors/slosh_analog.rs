@@ -54,7 +54,7 @@ const RITZ_TERMS: usize = 24;
 
 /// Relative change of κ and m_s between `RITZ_TERMS − 4` and `RITZ_TERMS` terms above
 /// which the Ritz solution is refused as not converged.
-const RITZ_TOLERANCE: f64 = 1e-4;
+pub const RITZ_TOLERANCE: f64 = 1e-4;
 
 /// A liquid's properties.
 #[derive(Debug, Clone, Copy, PartialEq)]
