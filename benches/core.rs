@@ -174,6 +174,22 @@ fn bench_effector_rhs(repeats: usize) {
     }
 }
 
+/// a × b on plain arrays, for the hand-written reduced forms.
+#[inline(always)]
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// a · b on plain arrays, for the hand-written reduced forms.
+#[inline(always)]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// The nutation-damper scene's right-hand side in its reduced form, written by hand: the hub
 /// (mass M, principal inertia I) and one particle (mass m) on the body line r = r₀ + ρ p̂ with
 /// spring k and dashpot c. With the system's centre of mass fixed, the hub's translation is
@@ -212,16 +228,6 @@ impl ReducedDamper {
 
     #[inline(always)]
     fn rhs(&self, y: &[f64; 10], dy: &mut [f64; 10]) {
-        fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        }
-        fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-            a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-        }
         let w = [y[0], y[1], y[2]];
         let (rho, rho_dot) = (y[7], y[8]);
         let (i, p) = (self.inertia, self.direction);
@@ -377,16 +383,6 @@ struct ReducedPendulum {
 impl ReducedPendulum {
     #[inline(always)]
     fn rhs(&self, y: &[f64; 12], dy: &mut [f64; 12]) {
-        fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        }
-        fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-            a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-        }
         let w = [y[0], y[1], y[2]];
         let (phi, theta, phi_dot, theta_dot) = (y[7], y[8], y[9], y[10]);
         let [p1, p2, p3] = self.frame;

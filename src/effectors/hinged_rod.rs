@@ -101,8 +101,8 @@ pub const FLAP_WARN_DEG: f64 = 75.0;
 
 /// The flap angle folded into [0, π/2] (rad): arccos |cos θ_f|, the distance from θ_f to the
 /// nearest multiple of π, computed without a cosine (this is checked at every step).
-fn folded_flap(flap: f64) -> f64 {
-    let a = flap.abs();
+pub(crate) fn folded_angle(angle: f64) -> f64 {
+    let a = angle.abs();
     if a <= std::f64::consts::FRAC_PI_2 {
         return a;
     }
@@ -164,7 +164,7 @@ impl ParticleModel for HingedRod {
     }
     fn validity(&self, q: &[f64]) -> Option<Validity> {
         (self.freedom == HingeFreedom::FlapLag).then(|| Validity {
-            value: folded_flap(q[0]).to_degrees(),
+            value: folded_angle(q[0]).to_degrees(),
             warn: FLAP_WARN_DEG,
             limit: SINGULAR_COS_FLAP.acos().to_degrees(),
         })
@@ -434,12 +434,12 @@ mod tests {
             // arccos near 0 amplifies the cosine's rounding: 1e-8 rad there, 1e-15 elsewhere.
             let tolerance = if reference < 1e-3 { 1e-7 } else { 1e-12 };
             assert!(
-                (folded_flap(flap) - reference).abs() <= tolerance,
+                (folded_angle(flap) - reference).abs() <= tolerance,
                 "{flap}: {} against {reference}",
-                folded_flap(flap)
+                folded_angle(flap)
             );
         }
-        assert_eq!(folded_flap(-0.25), 0.25);
-        assert!(folded_flap(f64::NAN).is_nan());
+        assert_eq!(folded_angle(-0.25), 0.25);
+        assert!(folded_angle(f64::NAN).is_nan());
     }
 }

@@ -17,6 +17,7 @@
 //! The angles are singular where the rod lies along ±p̂₃ (θ = ±90°): φ is then undefined and
 //! the coordinate mass m l² cos² θ vanishes. The run stops there with a diagnosis.
 
+use super::hinged_rod::folded_angle;
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums, add_mass_and_first_moment};
 use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
 use crate::sincos::sin_cos;
@@ -52,16 +53,6 @@ pub const SINGULAR_COS_THETA: f64 = 0.05;
 /// |θ| (degrees, folded into [0°, 90°]) past which the pendulum warns that it nears the
 /// singularity: the φ inertia m l² cos² θ has fallen to cos² 75° = 7 % of its value at rest.
 pub const THETA_WARN_DEG: f64 = 75.0;
-
-/// θ folded into [0, π/2] (rad): its distance to the nearest multiple of π.
-fn folded(theta: f64) -> f64 {
-    let a = theta.abs();
-    if a <= std::f64::consts::FRAC_PI_2 {
-        return a;
-    }
-    let m = a % std::f64::consts::PI;
-    m.min(std::f64::consts::PI - m)
-}
 
 /// The pendulum frame of a rest direction `p1` (unit, body axes): p̂₃ = p̂₁ × ê_k / |…|, with ê_k
 /// the body axis least aligned with p̂₁ (the first on ties), and p̂₂ = p̂₃ × p̂₁. A rest direction
@@ -416,7 +407,7 @@ impl ParticleModel for SloshPendulum {
                 limit,
             },
             None => Validity {
-                value: folded(q[1]).to_degrees(),
+                value: folded_angle(q[1]).to_degrees(),
                 warn: THETA_WARN_DEG,
                 limit,
             },

@@ -192,8 +192,7 @@ pub(super) fn build(
     };
     let q0 = pair(&spec.initial_angles, "initial_angles", "rad")?;
     let u0 = pair(&spec.initial_rates, "initial_rates", "rad/s")?;
-    let theta = q0[1].abs() % std::f64::consts::PI;
-    let folded = theta.min(std::f64::consts::PI - theta).to_degrees();
+    let folded = crate::effectors::hinged_rod::folded_angle(q0[1]).to_degrees();
     if folded > THETA_WARN_DEG
         && let Some(s) = &spec.initial_angles
     {
