@@ -47,6 +47,7 @@ if [[ $report_only == 0 ]]; then
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
     "$VENV/bin/python" "$PEERS/basilisk_slosh.py"
+    "$VENV/bin/python" "$PEERS/basilisk_burn.py"
     "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
   # slosh_pendulum along Basilisk's sphericalPendulum trajectories (results/basilisk_slosh.json).
