@@ -261,7 +261,14 @@ pub(super) fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     } else {
         ("T+V+W", "drift")
     };
-    if s.spacecraft.conserves_momentum() {
+    if s.spacecraft.expels_mass() && s.spacecraft.conserves_momentum() {
+        // H plus what the exhaust carried out is conserved; the motor supplies energy.
+        println!(
+            "  drift: |H + exhaust| {:.3e}  H_N + exhaust {:.3e}; energy: supplied by the \
+             motor, not audited  |q| {:.3e}",
+            o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.q_norm
+        );
+    } else if s.spacecraft.conserves_momentum() {
         println!(
             "  {energy}: |H| {:.3e}  H_N {:.3e}  {label} {:.3e}  |q| {:.3e}",
             o.drift.h_norm_rel, o.drift.h_inertial_rel, o.drift.energy_rel, o.drift.q_norm

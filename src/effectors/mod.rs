@@ -12,6 +12,8 @@
 //! - [`Magnetorquer`]: coils commanded by a discrete B-dot detumbling law, saturated per axis.
 //! - [`MotorWheel`]: a driven rotor (free, torque profile, speed hold, or rate damping).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
+//! - [`Thruster`]: thrust from a nozzle, expelling its tank's propellant ([`propellant_tank`]):
+//!   the variable-mass terms and the exhaust's momentum.
 //! - [`Aerodynamic`]: drag on a constant projected area with a fixed centre of pressure,
 //!   and [`aerodynamic::ShapeAerodynamic`] on the facets of the body's shape.
 //!
@@ -33,12 +35,14 @@ pub mod motion;
 pub mod motor;
 pub mod motor_wheel;
 pub mod particles;
+pub mod propellant_tank;
 pub mod rayleigh;
 pub mod rod_lanes;
 pub mod slosh_analog;
 pub mod slosh_pendulum;
 pub mod solar_pressure;
 pub mod spring_mass;
+pub mod thruster;
 pub mod wheel;
 
 pub use aerodynamic::Aerodynamic;
@@ -55,6 +59,7 @@ pub use rayleigh::Rayleigh;
 pub use slosh_pendulum::SloshPendulum;
 pub use solar_pressure::SolarPressure;
 pub use spring_mass::SpringMass;
+pub use thruster::Thruster;
 pub use wheel::WheelDamper;
 
 #[cfg(test)]

@@ -105,7 +105,8 @@ const TELEMETRY_FIELDS: [(&str, &str, &str); 26] = [
     ),
     (
         "drift_h_rel",
-        "Relative change of |H| since the start, (|H| - |H0|)/|H0|",
+        "Relative change of |H| since the start, (|H| - |H0|)/|H0|; with a thruster, of |H plus \
+         the angular momentum the exhaust carried out|",
         DIMENSIONLESS,
     ),
     (
@@ -252,6 +253,18 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("slosh_pendulum", "theta_rate") => return fixed("Rate of theta", "rad/s"),
         ("slosh_pendulum", "swing_deg") => {
             return fixed("Angle between the rod and its rest direction", "deg");
+        }
+        ("thruster", "exhaust_momentum_x" | "exhaust_momentum_y" | "exhaust_momentum_z") => {
+            return fixed(
+                "Angular momentum the exhaust has carried out since the start, about the \
+                 centre of mass, inertial axes",
+                "N m s",
+            );
+        }
+        ("thruster", "propellant_mass") => return fixed("Propellant left in the tank", "kg"),
+        ("thruster", "thrust") => return fixed("Thrust magnitude", "N"),
+        ("thruster", "mass_flow") => {
+            return fixed("Mass flow leaving through the nozzle", "kg/s");
         }
         ("modal_appendage", "tip_flap") => {
             return fixed("Tip deflection along the flap direction", "m");

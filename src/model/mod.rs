@@ -28,6 +28,7 @@ pub use secular::{Secular, SecularMotion, SecularRates};
 use crate::integrate::OdeSystem;
 use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};
 use std::any::Any;
+
 use std::cell::RefCell;
 use std::fmt::Debug;
 
@@ -120,6 +121,16 @@ pub struct HubAcceleration {
     /// Power of the gravity gradient on the moving masses (W; [`TidalCoupling::power`]), for
     /// the gravity-gradient effector's work; 0 without it.
     pub tidal_power: f64,
+}
+
+/// The system's centre of mass C relative to the hub's centre of mass B (body axes).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct CentreOfMass {
+    /// c = r_C − r_B (m).
+    pub offset: Vector3<f64>,
+    /// v_C − v_B (m/s), the rate of the point C itself: the masses' momentum relative to B
+    /// over the total mass, plus the drift of C as mass leaves from where it is.
+    pub velocity: Vector3<f64>,
 }
 
 impl HubAcceleration {
@@ -257,6 +268,28 @@ pub trait Effector: Any + Debug + Send + Sync {
     /// Whether it moves mass relative to the hub (needs the hub's translation and mass).
     fn moves_mass(&self) -> bool {
         false
+    }
+    /// Whether it expels mass from the spacecraft (a thruster): the spacecraft's mass then
+    /// changes with time, the angular momentum it carries out is booked
+    /// ([`Effector::exhaust_rates`], [`Effector::momentum_carried_out`]), and the energy is not
+    /// conserved (the motor supplies it).
+    fn expels_mass(&self) -> bool {
+        false
+    }
+    /// For an effector that expels mass: overwrites, after [`Effector::derivatives`], the
+    /// rates of its states that book what the exhaust carries out, which need the system's
+    /// centre of mass `centre` (the spacecraft computes it only in scenes that expel mass).
+    fn exhaust_rates(&self, _hub: &HubState, _centre: &CentreOfMass, _x: &[f64], _dx: &mut [f64]) {}
+    /// The angular momentum its exhaust has carried out of the spacecraft since t = 0, about
+    /// the system's centre of mass (N m s, inertial axes): H + this is conserved.
+    fn momentum_carried_out(&self, _x: &[f64]) -> Vector3<f64> {
+        Vector3::zeros()
+    }
+    /// For an effector that expels mass: the rate of change of the mass it carries (kg/s, ≤ 0)
+    /// and the part of its first moment's rate (kg m/s, body axes, about B) that its
+    /// [`Momentum::linear`] does not hold: ṁ r_e for mass leaving at r_e.
+    fn mass_rate(&self, _t: f64) -> (f64, Vector3<f64>) {
+        (0.0, Vector3::zeros())
     }
     /// Whether it applies an external torque (then H is not conserved).
     fn is_external(&self) -> bool {
@@ -513,6 +546,9 @@ pub struct Spacecraft {
     /// The one effector that moves mass, when there is exactly one: it may eliminate the
     /// hub's translation itself ([`Effector::couple_alone`]).
     alone: Option<usize>,
+    /// Some effector expels mass ([`Effector::expels_mass`]): the right-hand side then books
+    /// what its exhaust carries out ([`Spacecraft::exhaust_rates`]).
+    expels_mass: bool,
     /// Whether that effector is the scene's only one, ungrouped, with no gravity gradient,
     /// and has a closed form for the whole right-hand side ([`Effector::has_rhs_alone`]): the
     /// right-hand side then first asks [`Spacecraft::lone_rhs`].
@@ -548,6 +584,7 @@ impl Spacecraft {
             group_scratch: Vec::new(),
             tidal_source: None,
             alone: None,
+            expels_mass: false,
             lone_only: false,
             dim: HUB_STATES,
         }
@@ -597,6 +634,7 @@ impl Spacecraft {
             }
             self.translation = true;
         }
+        self.expels_mass |= effector.expels_mass();
         if effector.acts_on_moving_masses() {
             if self.tidal_source.is_some() {
                 return Err(AddEffectorError(format!(
@@ -711,9 +749,16 @@ impl Spacecraft {
                 .all(|e| !e.is_external() || e.keeps_momentum_norm())
     }
 
-    /// Whether kinetic + elastic + dissipated energy is conserved (no prescribed motion).
+    /// Whether kinetic + elastic + dissipated energy is conserved (no prescribed motion, and
+    /// no motor supplying energy: no effector expels mass).
     pub fn conserves_energy(&self) -> bool {
-        self.motion.is_none()
+        self.motion.is_none() && !self.expels_mass
+    }
+
+    /// Whether some effector expels mass ([`Effector::expels_mass`]): the spacecraft's mass
+    /// changes, and the exhaust's angular momentum is booked.
+    pub fn expels_mass(&self) -> bool {
+        self.expels_mass
     }
 
     /// The initial state vector for body rates `omega` (rad/s) and attitude `q`.
@@ -988,6 +1033,55 @@ impl Spacecraft {
         true
     }
 
+    /// The rates of the bookkeeping of what the exhaust carries out
+    /// ([`Effector::exhaust_rates`]), given the system's centre of mass. Out of line and cold:
+    /// the other scenes' right-hand sides compile as before.
+    #[cold]
+    #[inline(never)]
+    fn exhaust_rates(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let hub = &HubState {
+            t,
+            omega: Vector3::new(y[0], y[1], y[2]),
+            attitude: &y[3..7],
+        };
+        let centre = self.centre_of_mass(hub, y);
+        for (k, e) in self.effectors.iter().enumerate() {
+            if e.expels_mass() {
+                let (off, n) = (self.offsets[k], self.lens[k]);
+                e.exhaust_rates(hub, &centre, &y[off..off + n], &mut dydt[off..off + n]);
+            }
+        }
+    }
+
+    /// The system's centre of mass relative to B at state `y`, from every effector's
+    /// [`Momentum`] (for effectors that expel mass).
+    fn centre_of_mass(&self, hub: &HubState, y: &[f64]) -> CentreOfMass {
+        let mut mass = self.hub_mass.unwrap_or(0.0);
+        let (mut first_moment, mut linear) = (Vector3::zeros(), Vector3::zeros());
+        let grouped = self.groups.iter().map(|g| g.momentum(hub, y));
+        let alone = (0..self.effectors.len())
+            .filter(|&k| !self.grouped[k])
+            .map(|k| self.effectors[k].momentum(hub, self.effector_states(k, y)));
+        for m in alone.chain(grouped) {
+            mass += m.mass;
+            first_moment += m.first_moment;
+            linear += m.linear;
+        }
+        // The point C moves at the masses' momentum over M, and also because mass leaves:
+        // d/dt (S / M) gains (Σ ṁ r_e − c Σ ṁ) / M.
+        let offset = first_moment / mass;
+        let (mut mass_rate, mut moment_rate) = (0.0, Vector3::zeros());
+        for e in &self.effectors {
+            let (dm, ds) = e.mass_rate(hub.t);
+            mass_rate += dm;
+            moment_rate += ds;
+        }
+        CentreOfMass {
+            offset,
+            velocity: (linear + moment_rate - mass_rate * offset) / mass,
+        }
+    }
+
     /// Right-hand side with the hub's accelerations taken from `solve(coupling)`.
     #[inline(always)]
     fn effector_rhs(
@@ -1024,6 +1118,7 @@ impl Spacecraft {
             if let Some(tidal) = &coupling.tidal {
                 accel.tidal_power = tidal.power(self.hub_mass.unwrap_or(0.0));
             }
+
             let use_groups = coupling.tidal.is_none();
             for (k, e) in self.effectors.iter().enumerate() {
                 if use_groups && self.grouped[k] {
@@ -1084,6 +1179,9 @@ impl Spacecraft {
         });
         dydt[..3].copy_from_slice(omega_dot.as_slice());
         quaternion_rate(&y[3..7], &omega, &mut dydt[3..7]);
+        if self.expels_mass {
+            self.exhaust_rates(t, y, dydt);
+        }
     }
 }
 
@@ -1249,6 +1347,9 @@ impl OdeSystem for Spacecraft {
         hub_dy[1] = omega_dot[1];
         hub_dy[2] = omega_dot[2];
         quaternion_rate(&y[3..7], &omega, &mut hub_dy[3..7]);
+        if self.expels_mass {
+            self.exhaust_rates(t, y, dydt);
+        }
     }
 }
 

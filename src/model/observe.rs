@@ -20,6 +20,10 @@ pub struct Observation {
     pub h_inertial: Vector3<f64>,
     /// `|H|` (N m s).
     pub h_norm: f64,
+    /// Angular momentum the exhaust has carried out since t = 0, about the centre of mass,
+    /// inertial frame (N m s; zero without a thruster): `h_inertial` plus this is constant
+    /// for a free system.
+    pub h_carried_out: Vector3<f64>,
     /// Kinetic energy of the whole spacecraft in its centre-of-mass frame (J).
     pub kinetic_energy: f64,
     /// Elastic energy stored in the effectors' springs (J).
@@ -42,6 +46,7 @@ impl Observation {
         Invariants {
             h_body: self.h_body,
             h_inertial: self.h_inertial,
+            h_carried_out: self.h_carried_out,
             kinetic_energy: self.kinetic_energy,
             elastic_energy: self.elastic_energy,
             dissipated_energy: self.dissipated_energy,
@@ -70,6 +75,8 @@ pub struct Invariants {
     pub h_body: Vector3<f64>,
     /// Angular momentum, inertial frame (N m s).
     pub h_inertial: Vector3<f64>,
+    /// Angular momentum carried out by exhaust since t = 0, inertial frame (N m s).
+    pub h_carried_out: Vector3<f64>,
     /// Kinetic energy (J).
     pub kinetic_energy: f64,
     /// Elastic energy (J).
@@ -100,6 +107,7 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
     let mut kinetic_energy = 0.5 * omega.dot(&(sc.hub.inertia * omega));
     let (mut elastic_energy, mut dissipated_energy, mut dissipation_power) = (0.0, 0.0, 0.0);
     let mut external_work = 0.0;
+    let mut h_carried_out = Vector3::zeros();
     if !sc.effectors().is_empty() {
         let hub = HubState {
             t,
@@ -132,6 +140,11 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
             dissipation_power += a.power;
             external_work += a.work;
         }
+        if sc.expels_mass() {
+            for (i, e) in sc.effectors().iter().enumerate() {
+                h_carried_out += e.momentum_carried_out(sc.effector_states(i, y));
+            }
+        }
         // The system's linear momentum is zero, so the hub moves at v_B = −P_rel / M; that
         // adds S × v_B to H and −½ |P_rel|² / M to T (values about the system centre of mass).
         if total_mass > 0.0 && linear != Vector3::zeros() {
@@ -144,6 +157,7 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
     let inv = Invariants {
         h_body,
         h_inertial,
+        h_carried_out,
         kinetic_energy,
         elastic_energy,
         dissipated_energy,
@@ -178,6 +192,7 @@ pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64], angles: bool) -> Obser
         h_body: inv.h_body,
         h_inertial: inv.h_inertial,
         h_norm: inv.h_body.norm(),
+        h_carried_out: inv.h_carried_out,
         kinetic_energy: inv.kinetic_energy,
         elastic_energy: inv.elastic_energy,
         dissipated_energy: inv.dissipated_energy,

@@ -28,6 +28,7 @@ mod rayleigh;
 mod slosh_pendulum;
 mod solar_pressure;
 mod spring_mass_damper;
+mod thruster;
 mod wheel;
 mod wheel_damper;
 
@@ -42,6 +43,7 @@ use rayleigh::RayleighSpec;
 use slosh_pendulum::SloshPendulumSpec;
 use solar_pressure::SolarPressureSpec;
 use spring_mass_damper::SpringMassSpec;
+use thruster::ThrusterSpec;
 use wheel::MotorWheelSpec;
 use wheel_damper::WheelSpec;
 
@@ -68,6 +70,8 @@ pub enum EffectorSpec {
     SloshPendulum(SloshPendulumSpec),
     /// Modal cantilever beam.
     ModalAppendage(ModalSpec),
+    /// A thruster or motor expelling its tank's propellant.
+    Thruster(Box<ThrusterSpec>),
     /// Gravity-gradient torque of the central body (needs `orbit:`).
     GravityGradient(GravityGradientSpec),
     /// A constant magnetic dipole moment in the Earth's field (needs `orbit:`).
@@ -317,6 +321,7 @@ pub(super) fn build(
             EffectorSpec::HingedRod(_) => "hinged_rod",
             EffectorSpec::SloshPendulum(_) => "slosh_pendulum",
             EffectorSpec::ModalAppendage(_) => "modal_appendage",
+            EffectorSpec::Thruster(_) => "thruster",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
             EffectorSpec::Magnetorquer(_) => "magnetorquer",
@@ -464,6 +469,9 @@ pub(super) fn build(
             }
             EffectorSpec::ModalAppendage(m) => {
                 modal_appendage::build(&ck, cx, m, name_of(&m.name), &mut out)?;
+            }
+            EffectorSpec::Thruster(t) => {
+                out.push(Box::new(thruster::build(&ck, cx, t, name_of(&t.name))?));
             }
         }
     }

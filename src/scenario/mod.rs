@@ -896,7 +896,11 @@ fn drift_limits(
             &bounds.energy,
             "energy",
             sc.conserves_energy(),
-            "a prescribed motion does work on it",
+            if sc.expels_mass() {
+                "a thruster's motor supplies energy to it"
+            } else {
+                "a prescribed motion does work on it"
+            },
         )?,
         quaternion_norm: bound(&bounds.quaternion_norm, "quaternion_norm", true, "")?,
         on_drift,

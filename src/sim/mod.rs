@@ -109,9 +109,11 @@ impl Status {
 /// Largest deviations of the invariants over all accepted steps.
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct Drift {
-    /// max |(|H| − |H₀|)| / |H₀|.
+    /// max |(|H| − |H₀|)| / |H₀|; with a thruster, H is H_N plus the angular momentum the
+    /// exhaust carried out.
     pub h_norm_rel: f64,
-    /// max |H_N − H_N₀| / |H₀| (the inertial momentum vector).
+    /// max |H_N − H_N₀| / |H₀| (the inertial momentum vector; with a thruster, plus what the
+    /// exhaust carried out).
     pub h_inertial_rel: f64,
     /// max |E − E₀| / E₀ for the energy balance E = kinetic + elastic + dissipated (just T
     /// for a rigid body).
@@ -138,9 +140,15 @@ impl Reference {
         }
     }
 
-    /// Signed relative change of |H| at `o`.
+    /// Signed relative change of |H| at `o` (with a thruster, of |H plus what the exhaust
+    /// carried out|, the conserved quantity).
     pub fn h_rel(&self, o: &Observation) -> f64 {
-        rel(o.h_norm - self.h0, self.h0)
+        let h = if o.h_carried_out == Vector3::zeros() {
+            o.h_norm
+        } else {
+            (o.h_inertial + o.h_carried_out).norm()
+        };
+        rel(h - self.h0, self.h0)
     }
 
     /// Signed relative change of the energy balance (kinetic + elastic + dissipated) at `o`.
@@ -149,13 +157,17 @@ impl Reference {
     }
 
     fn update(&self, d: &mut Drift, i: &Invariants) {
-        let h = rel(i.h_body.norm() - self.h0, self.h0);
+        // With a thruster, H plus what the exhaust carried out is the conserved quantity (the
+        // carried part is zero otherwise).
+        let h_audited = i.h_inertial + i.h_carried_out;
+        let h = rel(h_audited.norm() - self.h0, self.h0);
         d.h_norm_rel = d.h_norm_rel.max(h.abs());
         let e = rel(i.energy_balance() - self.e0, self.e0);
         d.energy_rel = d.energy_rel.max(e.abs());
-        d.h_inertial_rel = d
-            .h_inertial_rel
-            .max(rel((i.h_inertial - self.h_inertial0).norm(), self.h0));
+        d.h_inertial_rel = d.h_inertial_rel.max(rel(
+            (i.h_inertial + i.h_carried_out - self.h_inertial0).norm(),
+            self.h0,
+        ));
         d.q_norm = d.q_norm.max(i.q_norm_error.abs());
     }
 }
@@ -490,7 +502,7 @@ fn drive<M: Stepper>(
     let mut last_good: Option<f64> = None;
     let mut last_poll = Instant::now();
     // Scenes without a prescribed motion conserve the energy balance.
-    let passive = sc.motion().is_none();
+    let passive = sc.conserves_energy();
     // Set when the last step ended on an effector's breakpoint.
     let mut at_breakpoint = false;
     while status.is_none() && stepper.t() < t_end {

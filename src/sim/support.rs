@@ -31,16 +31,20 @@ pub enum Feature {
     InternalEffectors,
     /// A prescribed hub rotation (`hub_motion`).
     PrescribedMotion,
+    /// Mass leaving the spacecraft (a thruster expelling its tank's propellant): the mass
+    /// properties change with time.
+    VariableMass,
 }
 
 impl Feature {
     /// Every feature, in the table's column order.
-    pub const ALL: [Feature; 5] = [
+    pub const ALL: [Feature; 6] = [
         Feature::DissipationTorques,
         Feature::EnvironmentTorques,
         Feature::HeldStates,
         Feature::InternalEffectors,
         Feature::PrescribedMotion,
+        Feature::VariableMass,
     ];
 
     /// A short name for tables and messages.
@@ -51,6 +55,7 @@ impl Feature {
             Feature::HeldStates => "held states and breakpoints",
             Feature::InternalEffectors => "internal effectors",
             Feature::PrescribedMotion => "prescribed hub motion",
+            Feature::VariableMass => "variable mass",
         }
     }
 }
@@ -77,6 +82,9 @@ impl Features {
                 Feature::EnvironmentTorques
             };
             f.add(class, &who);
+            if e.expels_mass() {
+                f.add(Feature::VariableMass, &who);
+            }
             if e.next_breakpoint(0.0).is_some_and(|t| t < duration) {
                 f.add(Feature::HeldStates, &who);
             }
@@ -165,7 +173,10 @@ pub fn support(method: &Method, feature: Feature) -> Support {
         // Averaging needs a torque-free motion to average over, and torques or effectors
         // whose effect averages over it.
         (Method::Averaged(_), DissipationTorques | InternalEffectors) => Support::Partly,
-        (Method::Averaged(_), EnvironmentTorques | HeldStates | PrescribedMotion) => Support::No,
+        (
+            Method::Averaged(_),
+            EnvironmentTorques | HeldStates | PrescribedMotion | VariableMass,
+        ) => Support::No,
         _ => Support::Yes,
     }
 }
@@ -176,7 +187,10 @@ impl Method {
     /// stepper starts ([`crate::averaging::AveragedStepper::new`]).
     pub fn refusal(&self, sc: &Spacecraft, duration: f64) -> Option<Refusal> {
         let features = Features::of(sc, duration);
-        for feature in Feature::ALL {
+        // Variable mass first: a thruster's table also brings breakpoints, and the changing
+        // mass is the more telling reason.
+        let order = std::iter::once(Feature::VariableMass).chain(Feature::ALL);
+        for feature in order {
             if support(self, feature) != Support::No {
                 continue;
             }
@@ -195,6 +209,11 @@ impl Method {
                     "averages over the torque-free motion, and an environmental or control \
                      torque does not average over it (it depends on the orbit, the field, \
                      time or a controller's samples)",
+                    "dop853",
+                ),
+                (Method::Averaged(_), Feature::VariableMass) => (
+                    "averages over the torque-free motion of a body of constant mass, and a \
+                     thruster changes the mass properties as it burns",
                     "dop853",
                 ),
                 (Method::Averaged(_), Feature::HeldStates) => (
@@ -266,7 +285,7 @@ impl Linearisation {
 pub fn linearize_support(kind: Linearisation, feature: Feature) -> Support {
     use Feature::*;
     match (kind, feature) {
-        (_, HeldStates) => Support::No,
+        (_, HeldStates | VariableMass) => Support::No,
         (Linearisation::Spin, EnvironmentTorques | PrescribedMotion) => Support::No,
         (Linearisation::Lvlh, EnvironmentTorques) => Support::Partly,
         (Linearisation::Lvlh, PrescribedMotion) => Support::No,
@@ -278,8 +297,11 @@ pub fn linearize_support(kind: Linearisation, feature: Feature) -> Support {
 /// Why the linearisation `kind` cannot treat `sc`, or `None`.
 pub fn linearize_refusal(sc: &Spacecraft, kind: Linearisation) -> Option<Refusal> {
     let features = Features::of(sc, f64::INFINITY);
-    // Held states first: a controller is the more telling name than the torque it applies.
-    let order = std::iter::once(Feature::HeldStates).chain(Feature::ALL);
+    // Variable mass and held states first: a thruster or a controller is the more telling
+    // name than the torque it applies.
+    let order = [Feature::VariableMass, Feature::HeldStates]
+        .into_iter()
+        .chain(Feature::ALL);
     for feature in order {
         if linearize_support(kind, feature) != Support::No {
             continue;
@@ -287,7 +309,12 @@ pub fn linearize_refusal(sc: &Spacecraft, kind: Linearisation) -> Option<Refusal
         let Some(source) = features.source(feature) else {
             continue;
         };
-        let reason = if feature == Feature::HeldStates {
+        let reason = if feature == Feature::VariableMass {
+            format!(
+                "linearize linearises a time-invariant system about an equilibrium, and {source} \
+                 expels mass: the mass properties change with time, so there is none"
+            )
+        } else if feature == Feature::HeldStates {
             format!(
                 "linearize linearises a time-invariant system, and {source} has states held \
                  between breakpoints (a sampled controller's command or a stepped torque): \
