@@ -286,6 +286,28 @@ fn what_a_thruster_cannot_do_is_refused_at_load_with_the_field_named() {
     );
     // Without the hub's mass the centre of mass is unknown.
     refused(&|y| y.replace(" mass: 500.0,", ""), &["body.mass"]);
+    // An emptying sphere may not be drained to its last percent.
+    refused(
+        &|y| {
+            y.replace(
+                "{model: uniform_burn, center: [0, 0, 0], axis: [0, 0, 1], radius: 0.5,\n             length: 0.9, propellant: 350.0}",
+                "{model: emptying, center: [0, 0, 0], axis: [0, 0, 1], radius: 0.4,\n             density: 1000.0, propellant: 107.0}",
+            )
+        },
+        &["tank.propellant", "under 1 % of the sphere"],
+    );
+    // The motor supplies energy: no energy-drift bound applies (the momentum audit does).
+    refused(
+        &|y| format!("{y}checks: {{max_drift: {{energy: 1.0e-8}}}}\n"),
+        &[
+            "checks.max_drift.energy",
+            "a thruster's motor supplies energy to it",
+        ],
+    );
+    assert!(
+        parsed(|y| format!("{y}checks: {{max_drift: {{momentum: 1.0e-10}}}}\n")).is_ok(),
+        "the momentum audit takes a bound"
+    );
 }
 
 #[test]

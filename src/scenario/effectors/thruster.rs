@@ -333,5 +333,25 @@ pub(super) fn build(
             ),
         ));
     }
+    // The emptying sphere's level speeds up without bound as the last liquid drains (the
+    // free surface's area vanishes at the outlet): keep 1 % of the sphere.
+    if let TankModel::Emptying { .. } = thruster.tank.model {
+        let floor = EMPTYING_FLOOR * thruster.tank.model.capacity();
+        if propellant - expelled < floor {
+            return Err(ck.err(
+                &spec.tank.value.propellant,
+                "tank.propellant",
+                format!(
+                    "the run leaves {:.6} kg in the emptying tank, under 1 % of the sphere \
+                     ({floor:.6} kg), where the model's free surface shrinks to the outlet \
+                     and its level's rate has no bound: shorten the burn or the run",
+                    propellant - expelled
+                ),
+            ));
+        }
+    }
     Ok(thruster)
 }
+
+/// The least fraction of an emptying sphere the run may leave in it.
+const EMPTYING_FLOOR: f64 = 0.01;
