@@ -56,6 +56,7 @@ from Basilisk.architecture import messaging
 from Basilisk.simulation import fuelTank, spacecraft, svIntegrators, thrusterDynamicEffector
 from Basilisk.utilities import RigidBodyKinematics as rbk
 from Basilisk.utilities import SimulationBaseClass, macros
+from quaternions import attitude_error
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
@@ -372,14 +373,6 @@ def run(s, settings, flags, times, g0=None, check_rhs=False, prime=True):
     return out, facts
 
 
-def attitude_error(a, b):
-    aw, ax, ay, az = a[0], -a[1], -a[2], -a[3]
-    bw, bx, by, bz = b
-    w = aw * bw - ax * bx - ay * by - az * bz
-    x = aw * bx + ax * bw + ay * bz - az * by
-    y = aw * by - ax * bz + ay * bw + az * bx
-    z = aw * bz + ax * by - ay * bx + az * bw
-    return 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
 
 
 def differences(a, b):

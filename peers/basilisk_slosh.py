@@ -32,6 +32,7 @@ import numpy as np
 import yaml
 from Basilisk.simulation import spacecraft, sphericalPendulum, svIntegrators
 from Basilisk.utilities import SimulationBaseClass, macros
+from quaternions import attitude_error
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -253,14 +254,6 @@ def run(s, settings, times):
     return out, facts
 
 
-def attitude_error(a, b):
-    aw, ax, ay, az = a[0], -a[1], -a[2], -a[3]
-    bw, bx, by, bz = b
-    w = aw * bw - ax * bx - ay * by - az * bz
-    x = aw * bx + ax * bw + ay * bz - az * by
-    y = aw * by - ax * bz + ay * bw + az * bx
-    z = aw * bz + ax * by - ay * bx + az * bw
-    return 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
 
 
 def differences(a, b):
