@@ -56,7 +56,7 @@ from Basilisk.architecture import messaging
 from Basilisk.simulation import fuelTank, spacecraft, svIntegrators, thrusterDynamicEffector
 from Basilisk.utilities import RigidBodyKinematics as rbk
 from Basilisk.utilities import SimulationBaseClass, macros
-from quaternions import attitude_error
+from peer_common import attitude_error, compact_json
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "results")
@@ -568,21 +568,6 @@ def basilisk_parameters(s, g0):
     }
 
 
-def compact_json(v, pad=""):
-    """JSON indented by structure, with lists of numbers and each sample on one line."""
-    inner = pad + " "
-    if isinstance(v, dict):
-        if not v:
-            return "{}"
-        if "t" in v and "omega" in v:
-            return json.dumps(v)
-        items = [f"{inner}{json.dumps(k)}: {compact_json(x, inner)}" for k, x in v.items()]
-        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if isinstance(v, list) and any(isinstance(x, (dict, list)) for x in v) and v:
-        if all(isinstance(x, list) and not any(isinstance(y, (dict, list)) for y in x) for x in v):
-            return json.dumps(v)
-        return "[\n" + ",\n".join(inner + compact_json(x, inner) for x in v) + "\n" + pad + "]"
-    return json.dumps(v)
 
 
 def main():

@@ -32,7 +32,7 @@ import numpy as np
 import yaml
 from Basilisk.simulation import spacecraft, sphericalPendulum, svIntegrators
 from Basilisk.utilities import SimulationBaseClass, macros
-from quaternions import attitude_error
+from peer_common import attitude_error, compact_json
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -272,21 +272,6 @@ def differences(a, b):
     }
 
 
-def compact_json(v, pad=""):
-    """JSON indented by structure, with lists of numbers and each sample on one line."""
-    inner = pad + " "
-    if isinstance(v, dict):
-        if not v:
-            return "{}"
-        if "t" in v and "omega" in v:
-            return json.dumps(v)
-        items = [f"{inner}{json.dumps(k)}: {compact_json(x, inner)}" for k, x in v.items()]
-        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
-    if isinstance(v, list) and any(isinstance(x, (dict, list)) for x in v) and v:
-        if all(isinstance(x, list) and not any(isinstance(y, (dict, list)) for y in x) for x in v):
-            return json.dumps(v)
-        return "[\n" + ",\n".join(inner + compact_json(x, inner) for x in v) + "\n" + pad + "]"
-    return json.dumps(v)
 
 
 def settings_label(st):

@@ -23,7 +23,7 @@ import numpy as np
 import yaml
 from Basilisk.simulation import linearSpringMassDamper, spacecraft
 from Basilisk.utilities import SimulationBaseClass, macros
-from quaternions import attitude_error
+from peer_common import attitude_error
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)

@@ -24,6 +24,7 @@ POLHODE = os.path.join(ROOT, "target", "release", "polhode")
 RUST_PEER = os.path.join(HERE, "rust-ode", "target", "release", "polhode-peer-rust-ode")
 sys.path.insert(0, HERE)
 import scipy_models  # noqa: E402
+from peer_common import attitude_error
 
 RTOLS = [1e-6, 1e-8, 1e-10, 1e-12]
 ATOL_FACTOR = 1e-2          # atol = rtol * ATOL_FACTOR for every run
@@ -99,15 +100,6 @@ def polhode_has(method):
         return False
 
 
-def attitude_error(q_ref, q):
-    """2 atan2(|vec(q_ref* (x) q)|, |scalar|) (rad): exact down to rounding (acos is not)."""
-    aw, ax, ay, az = q_ref[0], -q_ref[1], -q_ref[2], -q_ref[3]
-    bw, bx, by, bz = q
-    w = aw * bw - ax * bx - ay * by - az * bz
-    x = aw * bx + ax * bw + ay * bz - az * by
-    y = aw * by - ax * bz + ay * bw + az * bx
-    z = aw * bz + ax * by - ay * bx + az * bw
-    return 2.0 * math.atan2(math.sqrt(x * x + y * y + z * z), abs(w))
 
 
 def omega_q(point):
