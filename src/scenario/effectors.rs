@@ -498,6 +498,40 @@ pub(super) fn build(
     Ok(out)
 }
 
+/// A `[[t, v], …]` table (s, value): at least one point, finite numbers, times strictly
+/// increasing.
+fn time_table(
+    ck: &Check,
+    s: &Spanned<Vec<[f64; 2]>>,
+    key: &str,
+) -> Result<Vec<(f64, f64)>, ScenarioError> {
+    let points: Vec<(f64, f64)> = s.value.iter().map(|p| (p[0], p[1])).collect();
+    if points.is_empty() {
+        return Err(ck.err(s, key, "expected at least one [t, u] point"));
+    }
+    if let Some(p) = points
+        .iter()
+        .find(|p| !(p.0.is_finite() && p.1.is_finite()))
+    {
+        return Err(ck.err(
+            s,
+            key,
+            format!("expected finite numbers, got [{}, {}]", p.0, p.1),
+        ));
+    }
+    if let Some(w) = points.windows(2).find(|w| w[1].0 <= w[0].0) {
+        return Err(ck.err(
+            s,
+            key,
+            format!(
+                "the times must increase strictly (s): {} is followed by {}",
+                w[0].0, w[1].0
+            ),
+        ));
+    }
+    Ok(points)
+}
+
 /// Every copy's point must be on or in the body too.
 fn check_copies_on_body(
     ck: &Check,

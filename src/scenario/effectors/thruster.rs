@@ -108,7 +108,7 @@ fn profile(
         )?)),
         (None, Some(t)) => {
             let key = format!("{key}.table");
-            let points: Vec<(f64, f64)> = t.value.iter().map(|p| (p[0], p[1])).collect();
+            let points = super::time_table(ck, t, &key)?;
             if points.len() < 2 {
                 return Err(ck.err(t, &key, "expected at least two [t, value] points"));
             }
@@ -119,20 +119,11 @@ fn profile(
                     t,
                     &key,
                     format!(
-                        "expected finite times and values from 0 to {:e} ({unit}), got [{}, {}]",
+                        "expected times within ±{:e} s and values from 0 to {:e} ({unit}), got [{}, {}]",
+                        super::MAX_MAGNITUDE,
                         super::MAX_MAGNITUDE,
                         p.0,
                         p.1
-                    ),
-                ));
-            }
-            if let Some(w) = points.windows(2).find(|w| w[1].0 <= w[0].0) {
-                return Err(ck.err(
-                    t,
-                    &key,
-                    format!(
-                        "the times must increase strictly (s): {} is followed by {}",
-                        w[0].0, w[1].0
                     ),
                 ));
             }

@@ -142,33 +142,7 @@ fn profile(
     t: &TorqueSpec,
     at: &Spanned<MotorSpec>,
 ) -> Result<TorqueProfile, ScenarioError> {
-    let table = |s: &Spanned<Vec<[f64; 2]>>, key: &str| -> Result<Vec<(f64, f64)>, ScenarioError> {
-        let points: Vec<(f64, f64)> = s.value.iter().map(|p| (p[0], p[1])).collect();
-        if points.is_empty() {
-            return Err(ck.err(s, key, "expected at least one [t, u] point"));
-        }
-        if let Some(p) = points
-            .iter()
-            .find(|p| !(p.0.is_finite() && p.1.is_finite()))
-        {
-            return Err(ck.err(
-                s,
-                key,
-                format!("expected finite numbers, got [{}, {}]", p.0, p.1),
-            ));
-        }
-        if let Some(w) = points.windows(2).find(|w| w[1].0 <= w[0].0) {
-            return Err(ck.err(
-                s,
-                key,
-                format!(
-                    "the times must increase strictly (s): {} is followed by {}",
-                    w[0].0, w[1].0
-                ),
-            ));
-        }
-        Ok(points)
-    };
+    let table = |s: &Spanned<Vec<[f64; 2]>>, key: &str| super::time_table(ck, s, key);
     match (&t.constant, &t.linear, &t.steps) {
         (Some(c), None, None) if c.value.is_finite() => Ok(TorqueProfile::Constant(c.value)),
         (Some(c), None, None) => {
