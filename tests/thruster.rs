@@ -317,3 +317,33 @@ fn linearize_refuses_a_burning_stage() {
         .expect("a burning stage has no equilibrium");
     assert!(refusal.reason.contains("expels mass"), "{}", refusal.reason);
 }
+
+#[test]
+fn a_tank_analog_beside_a_thruster_is_warned_at_its_tank() {
+    let stage = std::fs::read_to_string("scenarios/spinning-stage-tanks.yaml").unwrap();
+    let engine = |thrust: f64| {
+        stage.replace(
+            "initial:\n",
+            &format!(
+                "  - thruster: {{name: engine, nozzle: [0, 0, -1.2], direction: [0, 0, 1],
+      thrust: {{constant: {thrust}}}, isp: 300.0,
+      tank: {{model: point, center: [0, 0, -0.5], propellant: 100.0}}}}
+initial:\n"
+            ),
+        )
+    };
+    let warned = |yaml: &str| {
+        scenario(yaml)
+            .warnings
+            .iter()
+            .filter(|w| {
+                w.to_string()
+                    .contains("`engine` accelerates the spacecraft")
+            })
+            .count()
+    };
+    // 2000 N on 1776 kg is 1.13 m/s², 0.06 of the 17.5 m/s² at the tanks: quiet; 4000 N warns
+    // at both tanks.
+    assert_eq!(warned(&engine(2000.0)), 0);
+    assert_eq!(warned(&engine(4000.0)), 2);
+}

@@ -173,6 +173,14 @@ impl Thruster {
         0.25 * self.exit_radius * self.exit_radius * (omega + d * d.dot(omega))
     }
 
+    /// The largest thrust of its profile (N).
+    pub fn peak_thrust(&self) -> f64 {
+        match &self.thrust {
+            Profile::Constant(v) => *v,
+            Profile::Table { points, .. } => points.iter().map(|p| p.1).fold(0.0, f64::max),
+        }
+    }
+
     /// The mass flow ṁ ≥ 0 (kg/s) at `t` and its rate (kg/s²).
     pub fn mass_flow(&self, t: f64) -> (f64, f64) {
         match &self.flow {

@@ -298,6 +298,8 @@ pub(super) struct Context<'a> {
     pub epoch_loc: Option<(u32, u32)>,
     /// The run's duration (s), which bounds the ticks a discrete controller may take.
     pub duration: f64,
+    /// The hub's mass (`body.mass`, kg), if given.
+    pub hub_mass: Option<f64>,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -495,7 +497,76 @@ pub(super) fn build(
              beams, wheels): model the dissipation with those instead",
         ));
     }
+    thrust_beside_slosh_analogs(cx, specs, &out);
     Ok(out)
+}
+
+/// A slosh analog derived from a tank is designed in the spin's centrifugal field at t = 0; a
+/// thruster's acceleration is another restoring field, which the dynamics apply to the
+/// pendulum but the analog's frequency and damping do not follow. Warns, at the tank, where
+/// the thrusters' peak acceleration exceeds a tenth of that field.
+fn thrust_beside_slosh_analogs(
+    cx: &Context,
+    specs: &[Spanned<EffectorSpec>],
+    out: &[Box<dyn Effector>],
+) {
+    use crate::effectors::Thruster;
+    let thrusters = out
+        .iter()
+        .filter_map(|e| (e.as_ref() as &dyn std::any::Any).downcast_ref::<Thruster>());
+    let (peak, names): (f64, Vec<&str>) = thrusters.fold((0.0, Vec::new()), |(f, mut n), t| {
+        n.push(t.name());
+        (f + t.peak_thrust(), n)
+    });
+    if peak <= 0.0 {
+        return;
+    }
+    let hub = crate::model::HubState {
+        t: 0.0,
+        omega: cx.omega0,
+        attitude: &[1.0, 0.0, 0.0, 0.0],
+    };
+    let mass = cx.hub_mass.unwrap_or(0.0)
+        + out
+            .iter()
+            .map(|e| e.momentum(&hub, &e.initial_state()).mass)
+            .sum::<f64>();
+    let acceleration = peak / mass;
+    for (i, spanned) in specs.iter().enumerate() {
+        let EffectorSpec::SloshPendulum(s) = &spanned.value else {
+            continue;
+        };
+        let Some(tank) = &s.tank else { continue };
+        let center = Vector3::from(tank.value.center.value) + cx.shift;
+        let axis = cx.spin_axis;
+        let spin = cx.omega0.dot(&axis);
+        let field = spin * spin * (center - center.dot(&axis) * axis).norm();
+        if acceleration > 0.1 * field {
+            cx.notes.borrow_mut().push(ScenarioError::at(
+                cx.path,
+                loc(&tank.value.center),
+                format!("effectors[{i}].slosh_pendulum.tank"),
+                format!(
+                    "the slosh analog is derived in the spin's centrifugal field at the tank, \
+                     {field:.4} m/s², and {} {} the spacecraft by up to {acceleration:.4} m/s² \
+                     ({:.2} times that): the dynamics apply that field to the pendulum, but its \
+                     length and damping stay the analog's for the spin alone \
+                     (docs/slosh-analogs.md)",
+                    names
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if names.len() == 1 {
+                        "accelerates"
+                    } else {
+                        "accelerate"
+                    },
+                    acceleration / field
+                ),
+            ));
+        }
+    }
 }
 
 /// A `[[t, v], …]` table (s, value): at least one point, finite numbers, times strictly

@@ -1133,6 +1133,7 @@ impl ScenarioFile {
             epoch_unix_ns,
             epoch_loc: loc_of(&self.epoch),
             duration,
+            hub_mass: mass,
         };
         let mut built = effectors::build(&cx, &self.effectors)?;
         let mut warnings = cx.notes.into_inner();
@@ -1165,6 +1166,7 @@ impl ScenarioFile {
                         epoch_unix_ns,
                         epoch_loc: loc_of(&self.epoch),
                         duration,
+                        hub_mass: mass,
                     };
                     built = effectors::build(&cx, &self.effectors)?;
                     warnings = cx.notes.into_inner();
