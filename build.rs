@@ -1,6 +1,7 @@
-//! Computes POLHODE_BUILD_ID: a hash of the sources and Cargo.lock, recorded in Monte Carlo
-//! manifests so that `polhode merge` can refuse shards written by different code (the package
-//! version alone does not change between commits or dependency updates).
+//! Computes POLHODE_BUILD_ID: a hash of the sources, the data they embed (data/) and
+//! Cargo.lock, recorded in Monte Carlo manifests so that `polhode merge` can refuse shards
+//! written by different code (the package version alone does not change between commits or
+//! dependency updates).
 
 use std::path::{Path, PathBuf};
 
@@ -22,6 +23,8 @@ fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into()));
     let mut paths = Vec::new();
     files(&root.join("src"), &mut paths);
+    // Model data that the sources embed (include_str!), e.g. the IGRF-14 coefficients.
+    files(&root.join("data"), &mut paths);
     paths.push(root.join("Cargo.lock"));
     paths.push(root.join("Cargo.toml"));
     paths.sort();
@@ -44,6 +47,7 @@ fn main() {
     }
     println!("cargo:rustc-env=POLHODE_BUILD_ID={h:016x}");
     println!("cargo:rerun-if-changed=src");
+    println!("cargo:rerun-if-changed=data");
     println!("cargo:rerun-if-changed=Cargo.lock");
     println!("cargo:rerun-if-changed=Cargo.toml");
 }

@@ -4,6 +4,7 @@
 //!   cargo bench --bench core            # full
 //!   cargo bench --bench core -- --quick # fewer repeats
 //!   cargo bench --bench core -- --effectors  # the effector scenes' right-hand sides only
+//!   cargo bench --bench core -- --igrf       # the degree-13 IGRF-14 field against the dipole
 //!
 //! 1. One RK4 step of the torque-free body through polhode's `Rk4` stepper and `Spacecraft`
 //!    system, against a minimal hand-written RK4 loop on `[f64; 7]` with the same equations.
@@ -645,6 +646,72 @@ fn bench_sin_cos(repeats: usize) {
     );
 }
 
+/// One evaluation of the IGRF-14 field to degree 13 (`orbit::igrf::Coefficients::field_ecef`,
+/// the coefficients of the year already formed) against the dipole's
+/// (`orbit::magnetic::Dipole::field_ecef`), at points spread over a LEO shell; and the cost of
+/// forming the year's coefficients (`Coefficients::igrf14`), once per epoch or per step.
+fn bench_igrf(repeats: usize) {
+    use nalgebra::Vector3;
+    use polhode::orbit::igrf::Coefficients;
+    use polhode::orbit::magnetic::Dipole;
+    let calls = 20_000;
+    let points: Vec<Vector3<f64>> = (0..calls)
+        .map(|k| {
+            let (lat, lon) = (1.3 * (k as f64 * 0.0137).sin(), k as f64 * 0.611);
+            let r = 6.878e6 + 3e5 * (k as f64 * 0.29).cos();
+            r * Vector3::new(lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin())
+        })
+        .collect();
+    let full = Coefficients::igrf14(2026.3).expect("in range");
+    let dipole = Dipole::igrf14(2026.3);
+    let mut igrf = || {
+        for p in &points {
+            black_box(full.field_ecef(black_box(p)));
+        }
+    };
+    let mut dip = || {
+        for p in &points {
+            black_box(dipole.field_ecef(black_box(p)));
+        }
+    };
+    let years = || (0..calls).map(|k| 1900.0 + 130.0 * k as f64 / calls as f64);
+    let mut coefficients = || {
+        for y in years() {
+            black_box(Coefficients::igrf14(black_box(y)).ok());
+        }
+    };
+    let mut dipole_coefficients = || {
+        for y in years() {
+            black_box(Dipole::igrf14(black_box(y)));
+        }
+    };
+    let (mut i_best, mut d_best, mut c_best, mut dc_best) =
+        (f64::INFINITY, f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        i_best = i_best.min(min_time(1, &mut igrf));
+        d_best = d_best.min(min_time(1, &mut dip));
+        c_best = c_best.min(min_time(1, &mut coefficients));
+        dc_best = dc_best.min(min_time(1, &mut dipole_coefficients));
+    }
+    let ns = |t: f64| t / calls as f64 * 1e9;
+    println!(
+        "
+IGRF-14 to degree 13 against the dipole (magnetic.rs), one call:"
+    );
+    println!(
+        "  field at a point: degree 13 {:.0} ns, dipole {:.1} ns, ratio {:.0}",
+        ns(i_best),
+        ns(d_best),
+        i_best / d_best
+    );
+    println!(
+        "  coefficients of a year: degree 13 {:.0} ns, dipole {:.1} ns, ratio {:.0}",
+        ns(c_best),
+        ns(dc_best),
+        c_best / dc_best
+    );
+}
+
 /// What aerodynamic drag adds to a rigid body's right-hand side: one constant area, and the
 /// facets of a box and of a cylinder (`from_shape: true`), in LEO.
 fn bench_drag_rhs(repeats: usize) {
@@ -699,7 +766,13 @@ fn main() {
         bench_reduced_pendulum(repeats);
         return;
     }
+    // `--igrf`: the IGRF-14 field against the dipole alone.
+    if std::env::args().any(|a| a == "--igrf") {
+        bench_igrf(repeats);
+        return;
+    }
     bench_environment_rhs(repeats);
+    bench_igrf(repeats);
     bench_sin_cos(repeats);
     bench_drag_rhs(repeats);
     // `--environment`: the environment torques alone.
