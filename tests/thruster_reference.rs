@@ -13,12 +13,11 @@
 //! (9000 N), a constant-volume sphere off the axis with a thrust table (ignition, regressive
 //! burn, tail-off at 50 s, then coast) and a 0.15 m exit, and an emptying sphere off the axis
 //! whose centre moves as it drains, with a tilted, offset nozzle.
+mod common;
+
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-use polhode::scenario::{Overrides, parse};
-use polhode::sim::{self, Control, Memory, Status};
+use polhode::sim::Status;
 use serde_json::Value;
-use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 /// The tolerance the scenes ask for (the reference's too), and polhode's own check: the same
 /// scenes at rtol 1e-14, atol 1e-16.
@@ -79,23 +78,7 @@ fn reference_points(samples: &Value) -> Vec<Point> {
 }
 
 fn polhode_points(yaml: &str, label: &str) -> Vec<Point> {
-    let scenario = parse(
-        Path::new(&format!("{label}.yaml")),
-        yaml.to_string(),
-        &Overrides::default(),
-    )
-    .unwrap_or_else(|e| panic!("{label}: {e}"));
-    let mut rec = Memory::new();
-    let stop = AtomicBool::new(false);
-    let out = sim::run(
-        &scenario,
-        &mut rec,
-        Control {
-            interrupt: &stop,
-            progress: None,
-        },
-    )
-    .unwrap();
+    let (out, rec) = common::run(&common::scenario(yaml));
     assert_eq!(out.status, Status::Complete, "{label}");
     rec.samples
         .iter()
