@@ -1033,6 +1033,25 @@ impl Spacecraft {
         true
     }
 
+    /// `start` plus every effector's [`Momentum`] at state `y` (grouped effectors' from their
+    /// group), summed in state order, then the groups'.
+    #[inline(always)]
+    pub(crate) fn summed_momentum(&self, hub: &HubState, y: &[f64], start: Momentum) -> Momentum {
+        let grouped = self.groups.iter().map(|g| g.momentum(hub, y));
+        let alone = (0..self.effectors.len())
+            .filter(|&k| !self.grouped[k])
+            .map(|k| self.effectors[k].momentum(hub, self.effector_states(k, y)));
+        let mut sum = start;
+        for m in alone.chain(grouped) {
+            sum.angular += m.angular;
+            sum.kinetic_energy += m.kinetic_energy;
+            sum.mass += m.mass;
+            sum.first_moment += m.first_moment;
+            sum.linear += m.linear;
+        }
+        sum
+    }
+
     /// The rates of the bookkeeping of what the exhaust carries out
     /// ([`Effector::exhaust_rates`]), given the system's centre of mass. Out of line and cold:
     /// the other scenes' right-hand sides compile as before.
@@ -1056,17 +1075,16 @@ impl Spacecraft {
     /// The system's centre of mass relative to B at state `y`, from every effector's
     /// [`Momentum`] (for effectors that expel mass).
     fn centre_of_mass(&self, hub: &HubState, y: &[f64]) -> CentreOfMass {
-        let mut mass = self.hub_mass.unwrap_or(0.0);
-        let (mut first_moment, mut linear) = (Vector3::zeros(), Vector3::zeros());
-        let grouped = self.groups.iter().map(|g| g.momentum(hub, y));
-        let alone = (0..self.effectors.len())
-            .filter(|&k| !self.grouped[k])
-            .map(|k| self.effectors[k].momentum(hub, self.effector_states(k, y)));
-        for m in alone.chain(grouped) {
-            mass += m.mass;
-            first_moment += m.first_moment;
-            linear += m.linear;
-        }
+        let start = Momentum {
+            mass: self.hub_mass.unwrap_or(0.0),
+            ..Momentum::default()
+        };
+        let Momentum {
+            mass,
+            first_moment,
+            linear,
+            ..
+        } = self.summed_momentum(hub, y, start);
         // The point C moves at the masses' momentum over M, and also because mass leaves:
         // d/dt (S / M) gains (Σ ṁ r_e − c Σ ṁ) / M.
         let offset = first_moment / mass;

@@ -1,6 +1,6 @@
 //! Quantities derived from a state at one instant: what every logged sample knows.
 
-use super::{HubState, Spacecraft};
+use super::{HubState, Momentum, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Derived quantities at one instant.
@@ -114,24 +114,16 @@ pub(super) fn invariants(sc: &Spacecraft, t: f64, y: &[f64]) -> (Invariants, Uni
             omega,
             attitude: &y[3..7],
         };
-        let mut total_mass = sc.hub_mass.unwrap_or(0.0);
-        let mut first_moment = Vector3::zeros();
-        let mut linear = Vector3::zeros();
-        // Grouped effectors' momentum comes from their group, together.
-        let grouped = sc.groups.iter().map(|g| g.momentum(&hub, y));
-        let alone = sc
-            .effectors()
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| !sc.grouped[*i]);
-        let alone = alone.map(|(i, e)| e.momentum(&hub, sc.effector_states(i, y)));
-        for m in alone.chain(grouped) {
-            h_body += m.angular;
-            kinetic_energy += m.kinetic_energy;
-            total_mass += m.mass;
-            first_moment += m.first_moment;
-            linear += m.linear;
-        }
+        let start = Momentum {
+            mass: sc.hub_mass.unwrap_or(0.0),
+            angular: h_body,
+            kinetic_energy,
+            ..Momentum::default()
+        };
+        let sum = sc.summed_momentum(&hub, y, start);
+        h_body = sum.angular;
+        kinetic_energy = sum.kinetic_energy;
+        let (total_mass, first_moment, linear) = (sum.mass, sum.first_moment, sum.linear);
         for (i, e) in sc.effectors().iter().enumerate() {
             let x = sc.effector_states(i, y);
             let a = e.energy(&hub, x);
