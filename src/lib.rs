@@ -116,6 +116,7 @@
 
 pub mod averaging;
 pub mod bench;
+pub mod chebyshev;
 pub mod cli;
 pub mod compare;
 pub mod effectors;

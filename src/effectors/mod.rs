@@ -23,6 +23,7 @@
 pub mod aerodynamic;
 pub mod beam;
 pub mod clock;
+pub mod draining_slosh;
 pub mod energy_sink;
 pub mod environment;
 pub mod gravity_gradient;
@@ -46,6 +47,7 @@ pub mod thruster;
 pub mod wheel;
 
 pub use aerodynamic::Aerodynamic;
+pub use draining_slosh::DrainingSlosh;
 pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};

@@ -364,10 +364,7 @@ pub fn slosh_analog(
             return Err(SloshError::Unsupported(CAPSULE_UNSUPPORTED));
         }
     };
-    let damping_ratio = match *tank {
-        Tank::Cylinder { .. } => cylinder_damping_ratio(ga, geometry.depth / radius),
-        _ => sphere_damping_ratio(liquid, field, radius, geometry.depth / radius),
-    };
+    let damping_ratio = damping_ratio_at_depth(tank, liquid, field, geometry.depth / radius);
     let liquid_mass = liquid.density * geometry.volume;
     let slosh_mass = liquid_mass * geometry.slosh_fraction;
     let fixed_mass = liquid_mass - slosh_mass;
@@ -486,6 +483,20 @@ pub fn cylinder_damping_ratio(galileo: f64, depth_ratio: f64) -> f64 {
     let x = 1.84 * depth_ratio;
     let bottom = 0.318 / x.sinh() * (1.0 + (1.0 - depth_ratio) / x.cosh());
     4.98 * galileo.sqrt() * (1.0 + bottom) / (2.0 * PI)
+}
+
+/// The viscous damping ratio ζ of the first mode in a smooth (unbaffled) `tank` with `liquid`
+/// at depth ratio h/R `depth_ratio`, in the field `field` (m/s²): the correlations
+/// [`cylinder_damping_ratio`] and Mikishev & Dorozhkin's for the sphere. An empirical fit, with
+/// a kink in its slope at half full for the sphere.
+pub fn damping_ratio_at_depth(tank: &Tank, liquid: &Liquid, field: f64, depth_ratio: f64) -> f64 {
+    let radius = tank.radius();
+    match *tank {
+        Tank::Cylinder { .. } => {
+            cylinder_damping_ratio(galileo_number(liquid, field, radius), depth_ratio)
+        }
+        _ => sphere_damping_ratio(liquid, field, radius, depth_ratio),
+    }
 }
 
 /// Viscous damping ratio of a smooth sphere: Mikishev & Dorozhkin's correlation as given in

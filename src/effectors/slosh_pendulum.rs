@@ -80,7 +80,7 @@ pub fn pendulum_frame_with_pole(p1: Vector3<f64>, p3: Vector3<f64>) -> [Vector3<
 impl SloshPendulum {
     /// The rod's direction ê, the unit vectors â = ∂ê/∂φ / cos θ and ∂ê/∂θ, and the
     /// convective Σ ∂²ê/∂q_j∂q_k u_j u_k at angles (φ, θ) and rates (φ̇, θ̇).
-    fn directions(&self, q: &[f64], u: &[f64]) -> [Vector3<f64>; 4] {
+    pub(crate) fn directions(&self, q: &[f64], u: &[f64]) -> [Vector3<f64>; 4] {
         let [p1, p2, p3] = self.frame;
         let (sp, cp) = sin_cos(q[0]);
         let (st, ct) = sin_cos(q[1]);

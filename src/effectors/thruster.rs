@@ -132,14 +132,17 @@ pub struct Thruster {
     pub thrust: Profile,
     /// The mass flow.
     pub flow: MassFlow,
-    /// The tank it draws on.
-    pub tank: PropellantTank,
-    /// Propellant in the tank at t = 0 (kg).
+    /// The tank it draws on; `None` when another effector carries the propellant and the
+    /// flow inside the spacecraft to this nozzle (a [`super::DrainingSlosh`] tank): this one
+    /// then adds the thrust and the exhaust's momentum flux alone.
+    pub tank: Option<PropellantTank>,
+    /// Propellant in the tank at t = 0 (kg); 0 without a tank.
     pub initial_propellant: f64,
 }
 
 impl Thruster {
-    /// A thruster named `name`; `direction` is normalised here.
+    /// A thruster named `name` drawing on `tank`, which holds `initial_propellant` (kg) at
+    /// t = 0; `direction` is normalised here.
     pub fn new(
         name: impl Into<String>,
         nozzle: Vector3<f64>,
@@ -150,14 +153,30 @@ impl Thruster {
         initial_propellant: f64,
     ) -> Thruster {
         Thruster {
+            tank: Some(tank),
+            initial_propellant,
+            ..Thruster::fed(name, nozzle, direction, thrust, flow)
+        }
+    }
+
+    /// A thruster whose propellant, and the flow inside the spacecraft to its nozzle, another
+    /// effector carries (a [`super::DrainingSlosh`] tank); `direction` is normalised here.
+    pub fn fed(
+        name: impl Into<String>,
+        nozzle: Vector3<f64>,
+        direction: Vector3<f64>,
+        thrust: Profile,
+        flow: MassFlow,
+    ) -> Thruster {
+        Thruster {
             name: name.into(),
             nozzle,
             direction: direction.normalize(),
             exit_radius: 0.0,
             thrust,
             flow,
-            tank,
-            initial_propellant,
+            tank: None,
+            initial_propellant: 0.0,
         }
     }
 
@@ -201,15 +220,17 @@ impl Thruster {
         }
     }
 
-    /// The propellant's mass properties at `t`.
-    pub fn tank_state(&self, t: f64) -> TankState {
+    /// The propellant's mass properties at `t`; `None` without a tank of its own.
+    pub fn tank_state(&self, t: f64) -> Option<TankState> {
         let (flow, flow_rate) = self.mass_flow(t);
         let mass = self.initial_propellant - self.expelled(t);
-        self.tank.state(mass, -flow, -flow_rate)
+        self.tank
+            .as_ref()
+            .map(|tank| tank.state(mass, -flow, -flow_rate))
     }
 
     /// The first time after `t` where the thrust or the flow is not smooth.
-    fn next_kink(&self, t: f64) -> Option<f64> {
+    pub fn next_kink(&self, t: f64) -> Option<f64> {
         let flow = match &self.flow {
             MassFlow::Given(p) => p.next_breakpoint(t),
             MassFlow::SpecificImpulse(_) => None,
@@ -254,40 +275,42 @@ impl Effector for Thruster {
     }
     fn couple(&self, hub: &HubState, _x: &[f64], c: &mut HubCoupling, _scratch: &mut [f64]) {
         let w = hub.omega;
-        let s = self.tank_state(hub.t);
-        let (m, r, v, a) = (s.mass, s.center, s.center_rate, s.center_accel);
         let (flow, flow_rate) = self.mass_flow(hub.t);
-        let j = s.inertia_about_b();
-        let dj = s.inertia_about_b_rate();
         let re = self.nozzle;
         let thrust = self.thrust.at(hub.t).0 * self.direction;
-        super::particles::add_mass_and_first_moment(&mut c.mass, m, &(m * r));
-        for i in 0..3 {
-            for k in 0..=i {
-                c.mass[(3 + i, 3 + k)] += j[(i, k)];
+        // The exhaust leaving at r_e: the thrust and the momentum flux ṁ (ω × r_e) relative
+        // to B's velocity (B's own cancels against the content's mass loss).
+        let mut force = thrust - flow * w.cross(&re);
+        let mut moment =
+            re.cross(&thrust) - flow * re.cross(&w.cross(&re)) - flow * self.exit_spread(&w);
+        if let Some(s) = self.tank_state(hub.t) {
+            let (m, r, v, a) = (s.mass, s.center, s.center_rate, s.center_accel);
+            let j = s.inertia_about_b();
+            let dj = s.inertia_about_b_rate();
+            super::particles::add_mass_and_first_moment(&mut c.mass, m, &(m * r));
+            for i in 0..3 {
+                for k in 0..=i {
+                    c.mass[(3 + i, 3 + k)] += j[(i, k)];
+                }
             }
-        }
-        // The flow inside, from the propellant's centre to the nozzle: its momentum and
-        // angular momentum about B and their body-frame rates.
-        let flow_path = re - r;
-        let (p_flow, h_flow) = (flow * flow_path, flow * r.cross(&re));
-        let dp_flow = flow_rate * flow_path - flow * v;
-        let dh_flow = flow_rate * r.cross(&re) + flow * v.cross(&re);
-        let force = thrust - w.cross(&w.cross(&(m * r))) + flow * w.cross(&(r - re))
-            - 2.0 * m * w.cross(&v)
-            + flow * v
-            - m * a
-            - dp_flow
-            - w.cross(&p_flow);
-        let rv = r.cross(&v);
-        let moment =
-            re.cross(&thrust) - w.cross(&(j * w)) - dj * w - flow * re.cross(&w.cross(&re))
-                + flow * rv
+            // The flow inside, from the propellant's centre to the nozzle: its momentum and
+            // angular momentum about B and their body-frame rates.
+            let flow_path = re - r;
+            let (p_flow, h_flow) = (flow * flow_path, flow * r.cross(&re));
+            let dp_flow = flow_rate * flow_path - flow * v;
+            let dh_flow = flow_rate * r.cross(&re) + flow * v.cross(&re);
+            force += flow * w.cross(&r) - w.cross(&w.cross(&(m * r))) - 2.0 * m * w.cross(&v)
+                + flow * v
+                - m * a
+                - dp_flow
+                - w.cross(&p_flow);
+            let rv = r.cross(&v);
+            moment += -w.cross(&(j * w)) - dj * w + flow * rv
                 - m * r.cross(&a)
                 - m * w.cross(&rv)
                 - dh_flow
-                - w.cross(&h_flow)
-                - flow * self.exit_spread(&w);
+                - w.cross(&h_flow);
+        }
         for i in 0..3 {
             c.force[i] += force[i];
             c.force[3 + i] += moment[i];
@@ -318,7 +341,9 @@ impl Effector for Thruster {
         dx[..3].copy_from_slice(inertial.as_slice());
     }
     fn momentum(&self, hub: &HubState, _x: &[f64]) -> Momentum {
-        let s = self.tank_state(hub.t);
+        let Some(s) = self.tank_state(hub.t) else {
+            return Momentum::default();
+        };
         let w = hub.omega;
         let velocity = w.cross(&s.center) + s.center_rate;
         let (flow, _) = self.mass_flow(hub.t);
@@ -340,15 +365,18 @@ impl Effector for Thruster {
         Vector3::new(x[0], x[1], x[2])
     }
     fn telemetry_names(&self) -> Vec<String> {
-        vec![
-            "propellant_mass".into(),
-            "thrust".into(),
-            "mass_flow".into(),
-        ]
+        let mut names = vec!["thrust".to_string(), "mass_flow".to_string()];
+        if self.tank.is_some() {
+            names.insert(0, "propellant_mass".into());
+        }
+        names
     }
     fn telemetry(&self, hub: &HubState, _x: &[f64]) -> Vec<f64> {
-        let s = self.tank_state(hub.t);
-        vec![s.mass, self.thrust.at(hub.t).0, -s.mass_rate]
+        let mut values = vec![self.thrust.at(hub.t).0, self.mass_flow(hub.t).0];
+        if let Some(s) = self.tank_state(hub.t) {
+            values.insert(0, s.mass);
+        }
+        values
     }
 }
 

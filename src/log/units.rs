@@ -251,6 +251,18 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         }
         ("slosh_pendulum", "phi_rate") => return fixed("Rate of phi", "rad/s"),
         ("slosh_pendulum", "theta_rate") => return fixed("Rate of theta", "rad/s"),
+        ("slosh_pendulum", "liquid_mass") => {
+            return fixed("Liquid left in the tank that a thruster drains", "kg");
+        }
+        ("slosh_pendulum", "fill") => {
+            return fixed("Fill fraction of the drained tank, by volume", "1");
+        }
+        ("slosh_pendulum", "slosh_mass") => {
+            return fixed("Sloshing mass of the analog at the present fill", "kg");
+        }
+        ("slosh_pendulum", "length") => {
+            return fixed("Pendulum length of the analog at the present fill", "m");
+        }
         ("slosh_pendulum", "swing_deg") => {
             return fixed("Angle between the rod and its rest direction", "deg");
         }

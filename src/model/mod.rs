@@ -276,6 +276,12 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn expels_mass(&self) -> bool {
         false
     }
+    /// Whether the mass it carries changes with time without leaving the spacecraft through
+    /// it (a tank that a thruster drains): the methods that need a constant mass refuse it,
+    /// as they refuse a thruster.
+    fn changes_mass(&self) -> bool {
+        self.expels_mass()
+    }
     /// For an effector that expels mass: overwrites, after [`Effector::derivatives`], the
     /// rates of its states that book what the exhaust carries out, which need the system's
     /// centre of mass `centre` (the spacecraft computes it only in scenes that expel mass).
@@ -634,7 +640,7 @@ impl Spacecraft {
             }
             self.translation = true;
         }
-        self.expels_mass |= effector.expels_mass();
+        self.expels_mass |= effector.changes_mass();
         if effector.acts_on_moving_masses() {
             if self.tidal_source.is_some() {
                 return Err(AddEffectorError(format!(

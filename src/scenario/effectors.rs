@@ -445,12 +445,11 @@ pub(super) fn build(
                 )?));
             }
             EffectorSpec::SloshPendulum(s) => {
-                out.push(Box::new(slosh_pendulum::build(
-                    &ck,
-                    cx,
-                    s,
-                    name_of(&s.name),
-                )?));
+                let feed = match s.tank.as_ref().and_then(|t| t.value.drained_by.as_ref()) {
+                    Some(by) => Some(feeding_thruster(cx, specs, by, &ck)?),
+                    None => None,
+                };
+                out.push(slosh_pendulum::build(&ck, cx, s, name_of(&s.name), feed)?);
             }
             EffectorSpec::Wheel(w) => {
                 wheel::build(
@@ -473,7 +472,11 @@ pub(super) fn build(
                 modal_appendage::build(&ck, cx, m, name_of(&m.name), &mut out)?;
             }
             EffectorSpec::Thruster(t) => {
-                out.push(Box::new(thruster::build(&ck, cx, t, name_of(&t.name))?));
+                let name = name_of(&t.name);
+                if t.tank.is_none() {
+                    fed_by_one_tank(cx, specs, &name, &ck, item)?;
+                }
+                out.push(Box::new(thruster::build(&ck, cx, t, name)?));
             }
         }
     }
@@ -499,6 +502,126 @@ pub(super) fn build(
     }
     thrust_beside_slosh_analogs(cx, specs, &out);
     Ok(out)
+}
+
+/// The name entry `j` of `specs` goes by: its `name`, or its kind (numbered when the list has
+/// more than one entry).
+fn thruster_name(specs: &[Spanned<EffectorSpec>], j: usize, given: &Option<String>) -> String {
+    given
+        .clone()
+        .filter(|s| !s.trim().is_empty())
+        .unwrap_or_else(|| {
+            if specs.len() > 1 {
+                format!("thruster_{}", j + 1)
+            } else {
+                "thruster".to_string()
+            }
+        })
+}
+
+/// The slosh tanks whose `drained_by` names thruster `name`: (entry index, the key).
+fn tanks_drained_by<'a>(
+    specs: &'a [Spanned<EffectorSpec>],
+    name: &str,
+) -> impl Iterator<Item = (usize, &'a Spanned<String>)> {
+    specs
+        .iter()
+        .enumerate()
+        .filter_map(move |(i, s)| match &s.value {
+            EffectorSpec::SloshPendulum(p) => p
+                .tank
+                .as_ref()
+                .and_then(|t| t.value.drained_by.as_ref())
+                .filter(|by| by.value == name)
+                .map(|by| (i, by)),
+            _ => None,
+        })
+}
+
+/// A thruster without a `tank:` draws on exactly one slosh tank that names it.
+fn fed_by_one_tank(
+    cx: &Context,
+    specs: &[Spanned<EffectorSpec>],
+    name: &str,
+    ck: &Check,
+    item: Option<(u32, u32)>,
+) -> Result<(), ScenarioError> {
+    let mut tanks = tanks_drained_by(specs, name);
+    if tanks.next().is_none() {
+        return Err(ScenarioError::at(
+            cx.path,
+            item,
+            format!("{}.tank", ck.prefix),
+            format!(
+                "missing field `tank`: thruster `{name}` needs a `tank:` (its depletion model \
+                 and propellant), or a `slosh_pendulum` whose `tank:` says \
+                 `drained_by: {name}`"
+            ),
+        ));
+    }
+    if let Some((i, by)) = tanks.next() {
+        return Err(ScenarioError::at(
+            cx.path,
+            loc(by),
+            format!("effectors[{i}].slosh_pendulum.tank.drained_by"),
+            format!(
+                "thruster `{name}` is already drained by an earlier tank: a thruster draws on \
+                 one tank (give each tank its own thruster entry, at the same nozzle if they \
+                 feed one engine)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The thruster that a slosh tank's `drained_by` names, built without a tank of its own (the
+/// tank's liquid is its propellant).
+fn feeding_thruster(
+    cx: &Context,
+    specs: &[Spanned<EffectorSpec>],
+    by: &Spanned<String>,
+    ck: &Check,
+) -> Result<crate::effectors::Thruster, ScenarioError> {
+    let mut names = Vec::new();
+    for (j, s) in specs.iter().enumerate() {
+        let EffectorSpec::Thruster(t) = &s.value else {
+            continue;
+        };
+        let name = thruster_name(specs, j, &t.name);
+        if name != by.value {
+            names.push(name);
+            continue;
+        }
+        if let Some(tank) = &t.tank {
+            return Err(ck.err(
+                by,
+                "tank.drained_by",
+                format!(
+                    "thruster `{name}` draws on its own `tank:` (effectors[{j}], line {}): \
+                     remove it there, so that this tank's liquid is its propellant",
+                    tank.referenced.line()
+                ),
+            ));
+        }
+        let thruster_check = Check {
+            path: cx.path,
+            prefix: format!("effectors[{j}].thruster"),
+        };
+        return thruster::build(&thruster_check, cx, t, name);
+    }
+    Err(ck.err(
+        by,
+        "tank.drained_by",
+        format!(
+            "no thruster is named `{}`{}",
+            by.value,
+            if names.is_empty() {
+                " (the scene has no thruster)".to_string()
+            } else {
+                format!(" (thrusters: {})", names.join(", "))
+            }
+        ),
+    ))
 }
 
 /// A slosh analog derived from a tank is designed in the spin's centrifugal field at t = 0; a

@@ -82,7 +82,7 @@ impl Features {
                 Feature::EnvironmentTorques
             };
             f.add(class, &who);
-            if e.expels_mass() {
+            if e.changes_mass() {
                 f.add(Feature::VariableMass, &who);
             }
             if e.next_breakpoint(0.0).is_some_and(|t| t < duration) {

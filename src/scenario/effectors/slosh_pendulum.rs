@@ -18,16 +18,22 @@
 //!       center: [0.5, 0.0, 0.2]           # m, body axes
 //!       fill: 0.5                         # by volume
 //!       liquid: {density: 1004.0, kinematic_viscosity: 9.0e-7, surface_tension: 0.066}
+//!       damping_factor: 1.0               # optional: × the smooth-wall damping (baffles)
+//!       drained_by: main_engine           # optional: a thruster without a `tank:` of its
+//!                                         # own draws this liquid, and the analog follows
+//!                                         # the fill as it falls
 //! ```
 
 use super::{Check, Context, ScenarioError};
-use crate::effectors::ParticleEffector;
+use crate::effectors::draining_slosh::{DrainingSlosh, FillCurves};
 use crate::effectors::slosh_analog::{
     Liquid, SPIN_NONUNIFORMITY_MAX, SloshAnalog, SloshWarning, Tank, slosh_analog, spin_field,
 };
 use crate::effectors::slosh_pendulum::{
     SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame, pendulum_frame_with_pole,
 };
+use crate::effectors::{ParticleEffector, Thruster};
+use crate::model::Effector;
 use nalgebra::Vector3;
 use serde::Deserialize;
 use serde_saphyr::Spanned;
@@ -84,6 +90,12 @@ pub struct TankSpec {
     pub fill: Spanned<f64>,
     /// The propellant.
     pub liquid: Spanned<LiquidSpec>,
+    /// The thruster that drains the tank (by name; it has no `tank:` of its own).
+    #[serde(default)]
+    pub drained_by: Option<Spanned<String>>,
+    /// Multiplies the smooth-wall damping of the analog (default 1; baffles raise it).
+    #[serde(default)]
+    pub damping_factor: Option<Spanned<f64>>,
 }
 
 /// The tank's shape.
@@ -122,13 +134,15 @@ pub struct LiquidSpec {
 /// [`SPIN_NONUNIFORMITY_MAX`] and this, the run is warned.
 const NONUNIFORMITY_REFUSE: f64 = 0.5;
 
-/// Validates a `slosh_pendulum:` entry and builds it.
+/// Validates a `slosh_pendulum:` entry and builds it; `feed` is the thruster its tank's
+/// `drained_by` names, built without a tank of its own.
 pub(super) fn build(
     ck: &Check,
     cx: &Context,
     spec: &SloshPendulumSpec,
     name: String,
-) -> Result<ParticleEffector<SloshPendulum>, ScenarioError> {
+    feed: Option<Thruster>,
+) -> Result<Box<dyn Effector>, ScenarioError> {
     let pair = |s: &Option<Spanned<[f64; 2]>>, key: &str, unit: &str| match s {
         None => Ok([0.0; 2]),
         Some(v) if v.value.iter().all(|x| x.abs() <= super::MAX_MAGNITUDE) => Ok(v.value),
@@ -141,8 +155,11 @@ pub(super) fn build(
             ),
         )),
     };
-    let model = match &spec.tank {
-        Some(tank) => from_tank(ck, cx, spec, tank)?,
+    let (model, setting) = match &spec.tank {
+        Some(tank) => {
+            let (model, setting) = from_tank(ck, cx, spec, tank)?;
+            (model, Some(setting))
+        }
         None => {
             let missing = |key: &str, what: &str| {
                 ScenarioError::at(
@@ -178,7 +195,7 @@ pub(super) fn build(
                 ),
                 None => pendulum_frame(p1),
             };
-            SloshPendulum {
+            let model = SloshPendulum {
                 mass: ck.positive(mass, "mass", "kg")?,
                 length: ck.positive(length, "length", "m")?,
                 pivot: ck.on_body(pivot, "pivot", "the pendulum's pivot", cx)? + cx.shift,
@@ -187,7 +204,8 @@ pub(super) fn build(
                 fixed_mass: 0.0,
                 fixed_position: Vector3::zeros(),
                 amplitude_warning: None,
-            }
+            };
+            (model, None)
         }
     };
     let q0 = pair(&spec.initial_angles, "initial_angles", "rad")?;
@@ -208,7 +226,92 @@ pub(super) fn build(
             ),
         ));
     }
-    Ok(ParticleEffector::new(name, model, &q0, &u0))
+    match (feed, setting, &spec.tank) {
+        (Some(feed), Some(setting), Some(tank)) => Ok(Box::new(draining(
+            ck, cx, tank, name, feed, model, setting, q0, u0,
+        )?)),
+        _ => Ok(Box::new(ParticleEffector::new(name, model, &q0, &u0))),
+    }
+}
+
+/// What the analog of a tank was derived from.
+struct TankSetting {
+    shape: Tank,
+    /// The tank's centre (m, body axes, about B).
+    center: Vector3<f64>,
+    /// × the smooth-wall damping.
+    damping_factor: f64,
+    liquid: Liquid,
+    /// The restoring acceleration (m/s²).
+    field: f64,
+}
+
+/// A tank drained by `feed`: the analog followed from the initial fill down to the fill the
+/// run ends at.
+#[allow(clippy::too_many_arguments)]
+fn draining(
+    ck: &Check,
+    cx: &Context,
+    tank: &Spanned<TankSpec>,
+    name: String,
+    feed: Thruster,
+    model: SloshPendulum,
+    setting: TankSetting,
+    q0: [f64; 2],
+    u0: [f64; 2],
+) -> Result<DrainingSlosh, ScenarioError> {
+    let t = &tank.value;
+    let drained_by = t
+        .drained_by
+        .as_ref()
+        .expect("a drained tank names its thruster");
+    let full_mass = setting.liquid.density * setting.shape.volume();
+    let fill = t.fill.value;
+    let initial_mass = fill * full_mass;
+    let expelled = feed.expelled(cx.duration);
+    if expelled >= initial_mass {
+        return Err(ck.err(
+            drained_by,
+            "tank.drained_by",
+            format!(
+                "thruster `{}` expels {expelled:.6} kg by the end of the run (t = {} s), and \
+                 the tank holds {initial_mass:.6} kg: shorten the burn or the run (burnout is \
+                 not modelled)",
+                feed.name(),
+                cx.duration
+            ),
+        ));
+    }
+    let end = (initial_mass - expelled) / full_mass;
+    // A run that drains (almost) nothing still follows the analog over a sliver of fill.
+    let lo = end.min(fill - 1e-6);
+    let (curves, _) = FillCurves::fit(&setting.shape, &setting.liquid, setting.field, lo, fill)
+        .map_err(|e| {
+            ck.err(
+                drained_by,
+                "tank.drained_by",
+                format!(
+                    "thruster `{}` drains the tank from fill {fill} to {end:.6} by the end of \
+                     the run (t = {} s), and the slosh analog cannot follow it there: {e}",
+                    feed.name(),
+                    cx.duration
+                ),
+            )
+        })?;
+    Ok(DrainingSlosh::new(
+        name,
+        feed,
+        setting.shape,
+        setting.center,
+        fill,
+        setting.liquid,
+        setting.field,
+        model.frame,
+        curves,
+        q0,
+        u0,
+    )
+    .with_damping_factor(setting.damping_factor))
 }
 
 /// The pendulum of a tank's first lateral slosh mode in the centrifugal field of the initial
@@ -219,7 +322,7 @@ fn from_tank(
     cx: &Context,
     spec: &SloshPendulumSpec,
     tank: &Spanned<TankSpec>,
-) -> Result<SloshPendulum, ScenarioError> {
+) -> Result<(SloshPendulum, TankSetting), ScenarioError> {
     for (given, key) in [
         (spec.mass.is_some(), "mass"),
         (spec.length.is_some(), "length"),
@@ -343,14 +446,28 @@ fn from_tank(
         ),
         None => pendulum_frame_with_pole(down, axis.cross(&down).normalize()),
     };
-    Ok(SloshPendulum {
+    let damping_factor = match &t.damping_factor {
+        Some(f) => ck.non_negative(f, "tank.damping_factor", "× the smooth-wall damping")?,
+        None => 1.0,
+    };
+    let model = SloshPendulum {
         mass: analog.slosh_mass,
         length: analog.pendulum_length,
         pivot: center + analog.pivot_height * up,
         frame,
-        damping: analog.dashpot,
+        damping: damping_factor * analog.dashpot,
         fixed_mass: analog.fixed_mass,
         fixed_position: center + analog.fixed_mass_height * up,
-        amplitude_warning: Some(analog.max_pendulum_angle(0.1, radius)),
-    })
+        amplitude_warning: Some(
+            analog.max_pendulum_angle(crate::effectors::draining_slosh::WAVE_RATIO, radius),
+        ),
+    };
+    let setting = TankSetting {
+        shape,
+        center,
+        damping_factor,
+        liquid,
+        field: field.acceleration,
+    };
+    Ok((model, setting))
 }

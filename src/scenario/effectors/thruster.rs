@@ -17,6 +17,10 @@
 //!       length: 0.8                   # m, cylinders
 //!       propellant: 400.0             # kg at t = 0
 //! ```
+//!
+//! Without `tank:`, a `slosh_pendulum` whose `tank:` says `drained_by: <this thruster's name>`
+//! holds the propellant, and its slosh analog follows the fill as it falls
+//! ([`crate::effectors::draining_slosh`]).
 
 use super::{Check, Context, ScenarioError};
 use crate::effectors::propellant_tank::{PropellantTank, TankModel};
@@ -48,8 +52,10 @@ pub struct ThrusterSpec {
     /// The mass flow (kg/s), instead of `isp`.
     #[serde(default)]
     pub mass_flow: Option<Spanned<ProfileSpec>>,
-    /// The tank it draws on.
-    pub tank: Spanned<PropellantTankSpec>,
+    /// The tank it draws on; absent when a `slosh_pendulum`'s tank names this thruster in
+    /// `drained_by` (that tank's liquid is then the propellant).
+    #[serde(default)]
+    pub tank: Option<Spanned<PropellantTankSpec>>,
 }
 
 /// A value against time: `{constant: v}` or `{table: [[t, v], …]}` (linear between the
@@ -303,18 +309,24 @@ pub(super) fn build(
             ));
         }
     };
-    let (tank, propellant) = tank(ck, cx, &spec.tank)?;
     let exit_radius = match &spec.exit_radius {
         Some(r) => ck.non_negative(r, "exit_radius", "m")?,
         None => 0.0,
     };
+    let Some(tank_spec) = &spec.tank else {
+        // A slosh tank drained by this thruster holds the propellant, and checks the burn.
+        return Ok(
+            Thruster::fed(name, nozzle, direction, thrust, flow).with_exit_radius(exit_radius)
+        );
+    };
+    let (tank, propellant) = tank(ck, cx, tank_spec)?;
     let thruster = Thruster::new(name, nozzle, direction, thrust, flow, tank, propellant)
         .with_exit_radius(exit_radius);
     // Burnout is not modelled: the tank must hold what the run expels.
     let expelled = thruster.expelled(cx.duration);
     if expelled >= propellant {
         return Err(ck.err(
-            &spec.tank.value.propellant,
+            &tank_spec.value.propellant,
             "tank.propellant",
             format!(
                 "the thrust profile expels {expelled:.6} kg by the end of the run \
@@ -326,11 +338,11 @@ pub(super) fn build(
     }
     // The emptying sphere's level speeds up without bound as the last liquid drains (the
     // free surface's area vanishes at the outlet): keep 1 % of the sphere.
-    if let TankModel::Emptying { .. } = thruster.tank.model {
-        let floor = EMPTYING_FLOOR * thruster.tank.model.capacity();
+    if let TankModel::Emptying { .. } = tank.model {
+        let floor = EMPTYING_FLOOR * tank.model.capacity();
         if propellant - expelled < floor {
             return Err(ck.err(
-                &spec.tank.value.propellant,
+                &tank_spec.value.propellant,
                 "tank.propellant",
                 format!(
                     "the run leaves {:.6} kg in the emptying tank, under 1 % of the sphere \
