@@ -65,6 +65,16 @@ fn quaternion(v: &Value) -> [f64; 4] {
     [f(&a[0]), f(&a[1]), f(&a[2]), f(&a[3])]
 }
 
+/// The hub state the environment torques see: time `t` (s) and attitude `q` (w, x, y, z);
+/// they do not depend on the rates.
+fn at(t: f64, q: &[f64; 4]) -> HubState<'_> {
+    HubState {
+        t,
+        omega: Vector3::zeros(),
+        attitude: q,
+    }
+}
+
 /// The orbit of the JSON elements (m, degrees; two-body, no J2 drift).
 fn orbit(el: &Value) -> Arc<Orbit> {
     let deg = |k: &str| f(&el[k]).to_radians();
@@ -117,7 +127,7 @@ fn polhode_torque(kind: &str, input: &Value, fed: &Value) -> Vector3<f64> {
                 orbit,
                 inertia,
             };
-            gg.environment_torque(t, &q)
+            gg.environment_torque(&at(t, &q))
         }
         "magnetic_dipole" => {
             let epoch_ns = epoch(input);
@@ -154,7 +164,7 @@ fn polhode_torque(kind: &str, input: &Value, fed: &Value) -> Vector3<f64> {
                 relative(&b, &b_fed) <= TORQUE_TOLERANCE,
                 "{label}: B in body axes {b:?} vs Basilisk's {b_fed:?}"
             );
-            md.environment_torque(t, &q)
+            md.environment_torque(&at(t, &q))
         }
         "aerodynamic" => {
             let h = r.norm() - CentralBody::EARTH.radius;
@@ -178,7 +188,7 @@ fn polhode_torque(kind: &str, input: &Value, fed: &Value) -> Vector3<f64> {
                 relative(&wind, &wind_fed) <= INPUT_TOLERANCE,
                 "{label}: relative wind {wind:?} vs Basilisk's {wind_fed:?}"
             );
-            aero.environment_torque(t, &q)
+            aero.environment_torque(&at(t, &q))
         }
         "solar_pressure" => {
             let epoch_ns = epoch(input);
@@ -209,7 +219,7 @@ fn polhode_torque(kind: &str, input: &Value, fed: &Value) -> Vector3<f64> {
                 "{label}: illuminated {lit}, Basilisk's shadow factor {}",
                 fed["shadow_factor"]
             );
-            sp.environment_torque(t, &q)
+            sp.environment_torque(&at(t, &q))
         }
         _ => panic!("unknown kind {kind}"),
     }

@@ -21,6 +21,7 @@
 pub mod facets;
 
 use super::environment::{EnvironmentTorque, names, to_body};
+use crate::model::HubState;
 use crate::orbit::Orbit;
 use facets::DragSurface;
 use nalgebra::Vector3;
@@ -158,14 +159,14 @@ impl EnvironmentTorque for Aerodynamic {
     fn kind(&self) -> &'static str {
         "aerodynamic"
     }
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        self.torque_at(t, q)
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
+        self.torque_at(hub.t, hub.attitude)
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&TELEMETRY)
     }
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
-        let (rho, wind) = self.density_and_wind(t, q);
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64> {
+        let (rho, wind) = self.density_and_wind(hub.t, hub.attitude);
         let tau = self.center_of_pressure.cross(&self.force(rho, &wind));
         telemetry_row(&tau, rho, &wind, work)
     }
@@ -230,14 +231,14 @@ impl EnvironmentTorque for ShapeAerodynamic {
     fn kind(&self) -> &'static str {
         "aerodynamic"
     }
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        self.torque_at(t, q)
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
+        self.torque_at(hub.t, hub.attitude)
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&TELEMETRY)
     }
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
-        let (rho, wind) = self.density_and_wind(t, q);
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64> {
+        let (rho, wind) = self.density_and_wind(hub.t, hub.attitude);
         let tau = self.force_and_torque(rho, &wind).1;
         telemetry_row(&tau, rho, &wind, work)
     }

@@ -4,30 +4,42 @@
 //!
 //! Each such torque is external and torque-only, and carries one bookkeeping state: the work
 //! it has done on the hub, W = ∫ τ·ω dt (J), which the energy balance subtracts. A model
-//! states only its name, kind, torque and telemetry.
+//! states only its name, kind, torque and telemetry, as functions of the hub state (time,
+//! attitude and rates: most use the first two, eddy currents the rates too), and, when its
+//! model holds only in a range of that state, where it stands.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Validity};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 
-/// An environmental torque on the hub, a function of time and attitude only.
+/// An environmental torque on the hub, a function of the hub state (time `hub.t`, the
+/// integrated attitude `hub.attitude` (w, x, y, z; body → inertial; not quite unit) and the
+/// body rates `hub.omega`).
 pub trait EnvironmentTorque: Debug + Send + Sync {
     /// Unique name (telemetry topic).
     fn name(&self) -> &str;
     /// The kind as written in YAML.
     fn kind(&self) -> &'static str;
-    /// The torque (N m, body axes) at time `t` (s) for the integrated attitude `q` (w, x, y,
-    /// z; body → inertial; not quite unit).
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64>;
+    /// The torque (N m, body axes) at the hub state `hub`.
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64>;
     /// Names of its telemetry fields (`work` among them; units in `log::units`).
     fn telemetry_names(&self) -> Vec<String>;
-    /// Telemetry values at `t`, `q`, with the work done so far `work` (J), in the order of
+    /// Telemetry values at `hub`, with the work done so far `work` (J), in the order of
     /// [`EnvironmentTorque::telemetry_names`].
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64>;
-    /// The gradient of its field (1/s², body axes) at `t`, `q`, when the field also acts on
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64>;
+    /// The gradient of its field (1/s², body axes) at `hub`, when the field also acts on
     /// the masses other effectors move ([`Effector::tidal_gradient`]); `None` otherwise.
-    fn tidal_gradient(&self, _t: f64, _q: &[f64]) -> Option<Matrix3<f64>> {
+    fn tidal_gradient(&self, _hub: &HubState) -> Option<Matrix3<f64>> {
         None
+    }
+    /// Where the hub state stands against the range its model holds in
+    /// ([`Effector::validity_at`]); `None` (the default) for a model without one.
+    fn validity(&self, _hub: &HubState) -> Option<Validity> {
+        None
+    }
+    /// [`EnvironmentTorque::validity`] in words: `(where it stands, remedy)`.
+    fn validity_report(&self, _hub: &HubState) -> (String, String) {
+        (String::new(), String::new())
     }
     /// Whether [`EnvironmentTorque::tidal_gradient`] gives a field.
     fn acts_on_moving_masses(&self) -> bool {
@@ -71,7 +83,7 @@ impl<T: EnvironmentTorque + 'static> Effector for T {
         EnvironmentTorque::acts_on_moving_masses(self)
     }
     fn tidal_gradient(&self, hub: &HubState) -> Option<Matrix3<f64>> {
-        EnvironmentTorque::tidal_gradient(self, hub.t, hub.attitude)
+        EnvironmentTorque::tidal_gradient(self, hub)
     }
     fn scratch_len(&self) -> usize {
         3
@@ -80,10 +92,10 @@ impl<T: EnvironmentTorque + 'static> Effector for T {
         true
     }
     fn torque(&self, hub: &HubState, _x: &[f64]) -> Vector3<f64> {
-        self.environment_torque(hub.t, hub.attitude)
+        self.environment_torque(hub)
     }
     fn couple(&self, hub: &HubState, _x: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
-        let tau = self.environment_torque(hub.t, hub.attitude);
+        let tau = self.environment_torque(hub);
         coupling.add_torque(&tau);
         scratch[..3].copy_from_slice(tau.as_slice());
     }
@@ -112,7 +124,13 @@ impl<T: EnvironmentTorque + 'static> Effector for T {
         EnvironmentTorque::telemetry_names(self)
     }
     fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
-        EnvironmentTorque::telemetry(self, hub.t, hub.attitude, x[0])
+        EnvironmentTorque::telemetry(self, hub, x[0])
+    }
+    fn validity_at(&self, hub: &HubState, _x: &[f64]) -> Option<Validity> {
+        EnvironmentTorque::validity(self, hub)
+    }
+    fn validity_report_at(&self, hub: &HubState, _x: &[f64]) -> (String, String) {
+        EnvironmentTorque::validity_report(self, hub)
     }
 }
 

@@ -16,6 +16,7 @@
 //! (J), which the energy balance subtracts.
 
 use super::environment::{EnvironmentTorque, names, to_body};
+use crate::model::HubState;
 use crate::orbit::Orbit;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::Arc;
@@ -73,14 +74,14 @@ impl EnvironmentTorque for GravityGradient {
     fn kind(&self) -> &'static str {
         "gravity_gradient"
     }
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        self.torque(t, q)
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
+        self.torque(hub.t, hub.attitude)
     }
     fn acts_on_moving_masses(&self) -> bool {
         true
     }
-    fn tidal_gradient(&self, t: f64, q: &[f64]) -> Option<Matrix3<f64>> {
-        Some(self.gradient(t, q))
+    fn tidal_gradient(&self, hub: &HubState) -> Option<Matrix3<f64>> {
+        Some(self.gradient(hub.t, hub.attitude))
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[
@@ -91,7 +92,8 @@ impl EnvironmentTorque for GravityGradient {
             "potential_energy",
         ])
     }
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64> {
+        let (t, q) = (hub.t, hub.attitude);
         let tau = self.torque(t, q);
         vec![tau[0], tau[1], tau[2], work, self.potential(t, q)]
     }

@@ -16,6 +16,7 @@
 //! conserved: B turns in inertial space as the spacecraft moves and the Earth rotates.)
 
 use super::environment::{EnvironmentTorque, names, to_body};
+use crate::model::HubState;
 use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -64,16 +65,16 @@ impl EnvironmentTorque for MagneticDipole {
     fn kind(&self) -> &'static str {
         "magnetic_dipole"
     }
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        self.torque_at(t, q)
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
+        self.torque_at(hub.t, hub.attitude)
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[
             "torque_x", "torque_y", "torque_z", "b_x", "b_y", "b_z", "work",
         ])
     }
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
-        let b = self.field_body(t, q);
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64> {
+        let b = self.field_body(hub.t, hub.attitude);
         let tau = self.moment.cross(&b);
         vec![tau[0], tau[1], tau[2], b[0], b[1], b[2], work]
     }

@@ -9,6 +9,7 @@
 //! - [`ModalBeam`]: a cantilever beam by its first bending modes, with geometric stiffening.
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
+//! - [`EddyCurrents`]: eddy-current damping of a conducting body by its magnetic tensor.
 //! - [`Magnetorquer`]: coils commanded by a discrete B-dot detumbling law, saturated per axis.
 //! - [`MotorWheel`]: a driven rotor (free, torque profile, speed hold, or rate damping).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
@@ -24,6 +25,7 @@ pub mod aerodynamic;
 pub mod beam;
 pub mod clock;
 pub mod draining_slosh;
+pub mod eddy_currents;
 pub mod energy_sink;
 pub mod environment;
 pub mod gravity_gradient;
@@ -48,6 +50,7 @@ pub mod wheel;
 
 pub use aerodynamic::Aerodynamic;
 pub use draining_slosh::DrainingSlosh;
+pub use eddy_currents::EddyCurrents;
 pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};

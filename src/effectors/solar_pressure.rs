@@ -17,6 +17,7 @@
 //! effector carries one bookkeeping state, the work done on the body W = ∫ τ·ω dt (J).
 
 use super::environment::{EnvironmentTorque, names, to_body};
+use crate::model::HubState;
 use crate::orbit::Orbit;
 use nalgebra::Vector3;
 use std::sync::Arc;
@@ -165,8 +166,8 @@ impl EnvironmentTorque for SolarPressure {
     fn kind(&self) -> &'static str {
         "solar_pressure"
     }
-    fn environment_torque(&self, t: f64, q: &[f64]) -> Vector3<f64> {
-        self.state_at(t, q).torque
+    fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
+        self.state_at(hub.t, hub.attitude).torque
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[
@@ -180,8 +181,8 @@ impl EnvironmentTorque for SolarPressure {
             "work",
         ])
     }
-    fn telemetry(&self, t: f64, q: &[f64], work: f64) -> Vec<f64> {
-        let st = self.state_at(t, q);
+    fn telemetry(&self, hub: &HubState, work: f64) -> Vec<f64> {
+        let st = self.state_at(hub.t, hub.attitude);
         vec![
             st.torque[0],
             st.torque[1],

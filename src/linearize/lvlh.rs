@@ -28,7 +28,12 @@ type C64 = Complex<f64>;
 
 /// Effector kinds whose torque varies around the orbit in LVLH (the magnetic field, the Sun
 /// direction, the co-rotating wind), so that no LVLH-fixed attitude is an equilibrium.
-const FORCED: [&str; 3] = ["magnetic_dipole", "solar_pressure", "aerodynamic"];
+const FORCED: [&str; 4] = [
+    "magnetic_dipole",
+    "eddy_currents",
+    "solar_pressure",
+    "aerodynamic",
+];
 
 /// Relative step of the central differences (rad for α, n for w, 1 for effector states):
 /// about ε^(1/3), where truncation and rounding errors balance (both ~1e-11 relative).

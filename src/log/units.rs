@@ -335,6 +335,42 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
         ("magnetic_dipole", "torque_z") => {
             return fixed("Magnetic torque m × B on the hub, body z", "N m");
         }
+        ("eddy_currents", "torque_x") => {
+            return fixed(
+                "Eddy-current torque (M (ω × B)) × B on the hub, body x",
+                "N m",
+            );
+        }
+        ("eddy_currents", "torque_y") => {
+            return fixed(
+                "Eddy-current torque (M (ω × B)) × B on the hub, body y",
+                "N m",
+            );
+        }
+        ("eddy_currents", "torque_z") => {
+            return fixed(
+                "Eddy-current torque (M (ω × B)) × B on the hub, body z",
+                "N m",
+            );
+        }
+        ("eddy_currents", "b_x") => return fixed("Magnetic field at the body, body x", "T"),
+        ("eddy_currents", "b_y") => return fixed("Magnetic field at the body, body y", "T"),
+        ("eddy_currents", "b_z") => return fixed("Magnetic field at the body, body z", "T"),
+        ("eddy_currents", "power") => {
+            return fixed("Power dissipated by the eddy currents, −τ·ω", "W");
+        }
+        ("eddy_currents", "reynolds") => {
+            return fixed(
+                "Magnetic Reynolds number μ0 σ |ω| h R / 2 (NaN for a tensor given directly)",
+                DIMENSIONLESS,
+            );
+        }
+        ("eddy_currents", "work") => {
+            return fixed(
+                "Work done by the eddy-current torque since the start (≤ 0)",
+                "J",
+            );
+        }
         ("magnetorquer", "dipole_x") => {
             return fixed("Commanded coil dipole, held between ticks, body x", "A m^2");
         }

@@ -466,6 +466,18 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn validity_report(&self, _x: &[f64]) -> (String, String) {
         (String::new(), String::new())
     }
+    /// Where it stands against the range its model holds in at the hub state `hub` and its
+    /// states `x`: what the run checks. The default is [`Effector::validity`], which sees its
+    /// states only; a model whose range depends on the hub's motion (eddy currents: the skin
+    /// depth, on |ω|) answers here instead.
+    fn validity_at(&self, _hub: &HubState, x: &[f64]) -> Option<Validity> {
+        self.validity(x)
+    }
+    /// [`Effector::validity_at`] in words: `(where it stands, remedy)`. The default is
+    /// [`Effector::validity_report`].
+    fn validity_report_at(&self, _hub: &HubState, x: &[f64]) -> (String, String) {
+        self.validity_report(x)
+    }
 }
 
 /// A prescribed hub rotation (a motor drives the hub; its centre of mass is pinned).
@@ -731,6 +743,15 @@ impl Spacecraft {
         for (k, e) in self.effectors.iter().enumerate() {
             let off = self.offsets[k] - HUB_STATES;
             e.at_breakpoint(&hub, &mut effector_part[off..off + self.lens[k]]);
+        }
+    }
+
+    /// The hub's part of the state `y` at time `t` (s), as the effectors see it.
+    pub fn hub_state<'a>(&self, t: f64, y: &'a [f64]) -> HubState<'a> {
+        HubState {
+            t,
+            omega: Vector3::new(y[0], y[1], y[2]),
+            attitude: &y[3..7],
         }
     }
 

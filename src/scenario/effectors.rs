@@ -17,6 +17,7 @@ use serde_saphyr::Spanned;
 use std::path::Path;
 
 mod aerodynamic;
+mod eddy_currents;
 mod energy_sink;
 mod gravity_gradient;
 mod hinged_rod;
@@ -33,6 +34,7 @@ mod wheel;
 mod wheel_damper;
 
 use aerodynamic::AerodynamicSpec;
+use eddy_currents::EddyCurrentsSpec;
 use energy_sink::EnergySinkSpec;
 use gravity_gradient::GravityGradientSpec;
 use hinged_rod::HingedRodSpec;
@@ -76,6 +78,8 @@ pub enum EffectorSpec {
     GravityGradient(GravityGradientSpec),
     /// A constant magnetic dipole moment in the Earth's field (needs `orbit:`).
     MagneticDipole(MagneticDipoleSpec),
+    /// Eddy-current damping of a conducting body in the Earth's field (needs `orbit:`).
+    EddyCurrents(EddyCurrentsSpec),
     /// Magnetorquer coils under B-dot control (needs `orbit:`).
     Magnetorquer(Box<MagnetorquerSpec>),
     /// Solar radiation pressure on a flat plate (needs `orbit:`).
@@ -326,6 +330,7 @@ pub(super) fn build(
             EffectorSpec::Thruster(_) => "thruster",
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
+            EffectorSpec::EddyCurrents(_) => "eddy_currents",
             EffectorSpec::Magnetorquer(_) => "magnetorquer",
             EffectorSpec::SolarPressure(_) => "solar_pressure",
             EffectorSpec::Aerodynamic(_) => "aerodynamic",
@@ -380,6 +385,17 @@ pub(super) fn build(
                     cx,
                     m,
                     name_of(&m.name),
+                    orbit,
+                    item,
+                )?));
+            }
+            EffectorSpec::EddyCurrents(e) => {
+                let orbit = needs_orbit()?;
+                out.push(Box::new(eddy_currents::build(
+                    &ck,
+                    cx,
+                    e,
+                    name_of(&e.name),
                     orbit,
                     item,
                 )?));

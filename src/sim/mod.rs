@@ -444,7 +444,10 @@ fn drive<M: Stepper>(
     let ranged: Vec<usize> = (0..sc.effectors().len())
         .filter(|&k| {
             sc.effectors()[k]
-                .validity(sc.effector_states(k, stepper.y()))
+                .validity_at(
+                    &sc.hub_state(0.0, stepper.y()),
+                    sc.effector_states(k, stepper.y()),
+                )
                 .is_some()
         })
         .collect();
@@ -902,7 +905,7 @@ pub fn diagnose(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
         .then(|| crate::linearize::stiffness(sc, t, y, sim.duration));
     let rho = stiffness.map_or(f64::NAN, |s| s.spectral_radius);
     let m = &sim.method;
-    let (cause, remedy) = if let Some(found) = model_outside_range(sc, y) {
+    let (cause, remedy) = if let Some(found) = model_outside_range(sc, t, y) {
         found
     } else if let Some(found) = unstable_sampled_loop(sc) {
         found
@@ -1067,15 +1070,17 @@ fn drift_message(what: &str, t: f64, y: &[f64], sim: &Simulation) -> String {
     )
 }
 
-/// The first effector outside the range its model holds in at state `y`: `(cause, remedy)`.
+/// The first effector outside the range its model holds in at time `t` and state `y`:
+/// `(cause, remedy)`.
 /// A failed integration near such a state is blamed on it rather than on generic stiffness
 /// (e.g. a flap–lag rod at its coordinate singularity, which no integrator gets past).
-fn model_outside_range(sc: &Spacecraft, y: &[f64]) -> Option<(String, String)> {
+fn model_outside_range(sc: &Spacecraft, t: f64, y: &[f64]) -> Option<(String, String)> {
+    let hub = sc.hub_state(t, y);
     sc.effectors().iter().enumerate().find_map(|(k, e)| {
         let x = sc.effector_states(k, y);
-        let v = e.validity(x)?;
+        let v = e.validity_at(&hub, x)?;
         v.past_limit().then(|| {
-            let (state, remedy) = e.validity_report(x);
+            let (state, remedy) = e.validity_report_at(&hub, x);
             (
                 format!(
                     "{} `{}` left its model's range: {state}",
@@ -1102,10 +1107,11 @@ fn check_validity(
     warnings: &mut Vec<Warning>,
 ) -> std::io::Result<Option<Status>> {
     let sc = &sim.spacecraft;
+    let hub = sc.hub_state(t, y);
     for &k in ranged {
         let e = &sc.effectors()[k];
         let x = sc.effector_states(k, y);
-        let Some(v) = e.validity(x) else {
+        let Some(v) = e.validity_at(&hub, x) else {
             continue;
         };
         let level = if v.past_limit() {
@@ -1118,7 +1124,7 @@ fn check_validity(
         if level <= reported[k] {
             continue;
         }
-        let (state, remedy) = e.validity_report(x);
+        let (state, remedy) = e.validity_report_at(&hub, x);
         let stop = level == 2 && sim.drift_limits.on_validity == OnBreach::Stop;
         if stop {
             return Ok(Some(Status::InvalidModel {
