@@ -710,6 +710,59 @@ IGRF-14 to degree 13 against the dipole (magnetic.rs), one call:"
         ns(dc_best),
         c_best / dc_best
     );
+    bench_field_on_orbit(repeats);
+}
+
+/// The field along a 500 km, 51.6° orbit over one day as a run sees it
+/// (`GeomagneticField::field_on_orbit`): the dipole, IGRF-14 tabulated along the orbit (the
+/// default), and IGRF-14 from the harmonics at every call (coefficients of the year included).
+fn bench_field_on_orbit(repeats: usize) {
+    use polhode::orbit::GeomagneticField;
+    use polhode::orbit::field_table::FieldTable;
+    let s = scenario::parse(
+        std::path::Path::new("bench.yaml"),
+        "name: b\nbody: {principal: [3, 5, 7]}\ninitial: {omega: [0, 0, 0.1]}\n\
+         duration: 86400\norbit: {semi_major_axis_km: 6878.137, inclination_deg: 51.6}\n"
+            .to_string(),
+        &Overrides::default(),
+    )
+    .expect("valid");
+    let orbit = s.orbit.clone().expect("an orbit");
+    let epoch = s.epoch_unix_ns;
+    let table = FieldTable::build(&orbit, epoch, 86_400.0)
+        .expect("in range")
+        .expect("a table");
+    let fields = [
+        ("dipole", GeomagneticField::new(epoch)),
+        (
+            "IGRF-14 tabulated",
+            GeomagneticField::igrf(epoch, Some(std::sync::Arc::new(table))),
+        ),
+        ("IGRF-14 harmonics", GeomagneticField::igrf(epoch, None)),
+    ];
+    let calls = 20_000;
+    let times: Vec<f64> = (0..calls)
+        .map(|k| k as f64 * 86_400.0 / calls as f64)
+        .collect();
+    let mut best = [f64::INFINITY; 3];
+    for _ in 0..repeats {
+        for (b, (_, field)) in best.iter_mut().zip(&fields) {
+            let mut along = || {
+                for &t in &times {
+                    black_box(field.field_on_orbit(&orbit, black_box(t)));
+                }
+            };
+            *b = b.min(min_time(1, &mut along));
+        }
+    }
+    println!("  along the orbit, one call (position, rotation and field):");
+    for (b, (name, _)) in best.iter().zip(&fields) {
+        println!(
+            "    {name}: {:.1} ns, {:.1} × the dipole",
+            b / calls as f64 * 1e9,
+            b / best[0]
+        );
+    }
 }
 
 /// What aerodynamic drag adds to a rigid body's right-hand side: one constant area, and the

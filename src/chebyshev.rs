@@ -25,6 +25,22 @@ pub struct Chebyshev {
     second: Vec<f64>,
 }
 
+/// The coefficients c_k of the interpolant through `values` at the n Chebyshev points of the
+/// first kind s_j = cos(π (j + ½)/n) of [−1, 1] (n = `values.len()`).
+pub fn coefficients(values: &[f64]) -> Vec<f64> {
+    let n = values.len();
+    (0..n)
+        .map(|k| {
+            let sum: f64 = values
+                .iter()
+                .enumerate()
+                .map(|(j, f)| f * (PI * k as f64 * (j as f64 + 0.5) / n as f64).cos())
+                .sum();
+            (if k == 0 { 1.0 } else { 2.0 }) * sum / n as f64
+        })
+        .collect()
+}
+
 /// The coefficients of the derivative (with respect to s) of Σ c_k T_k(s).
 fn derivative(c: &[f64]) -> Vec<f64> {
     let n = c.len();
@@ -40,8 +56,9 @@ fn derivative(c: &[f64]) -> Vec<f64> {
     d
 }
 
-/// Σ c_k T_k(s) by Clenshaw's recurrence.
-fn clenshaw(c: &[f64], s: f64) -> f64 {
+/// Σ c_k T_k(s) by Clenshaw's recurrence (`c` not empty).
+#[inline]
+pub fn clenshaw(c: &[f64], s: f64) -> f64 {
     let (mut b1, mut b2) = (0.0, 0.0);
     for &ck in c.iter().skip(1).rev() {
         let b0 = ck + 2.0 * s * b1 - b2;
@@ -65,16 +82,7 @@ impl Chebyshev {
     /// The interpolant on [a, b] (a < b) through `values` at [`Chebyshev::nodes`]`(a, b, n)`,
     /// n = `values.len()` ≥ 1.
     pub fn from_samples(a: f64, b: f64, values: &[f64]) -> Chebyshev {
-        let n = values.len();
-        let mut value = vec![0.0; n];
-        for (k, c) in value.iter_mut().enumerate() {
-            let sum: f64 = values
-                .iter()
-                .enumerate()
-                .map(|(j, f)| f * (PI * k as f64 * (j as f64 + 0.5) / n as f64).cos())
-                .sum();
-            *c = if k == 0 { 1.0 } else { 2.0 } * sum / n as f64;
-        }
+        let value = coefficients(values);
         let scale = 2.0 / (b - a);
         let first: Vec<f64> = derivative(&value).iter().map(|d| d * scale).collect();
         let second: Vec<f64> = derivative(&first).iter().map(|d| d * scale).collect();

@@ -346,7 +346,7 @@ fn scenario_yaml(kind: &str, input: &Value) -> String {
         "name: basilisk-state
 {epoch}body: {body}
 orbit: {{semi_major_axis_km: {:?}, eccentricity: {:?}, inclination_deg: {:?}, raan_deg: {:?}, \
-arg_perigee_deg: {:?}, true_anomaly_deg: {:?}}}
+arg_perigee_deg: {:?}, true_anomaly_deg: {:?}, magnetic_field: dipole}}
 initial: {{omega: [0.0, 0.0, 0.0]}}
 duration: 1.0
 effectors:

@@ -283,7 +283,7 @@ fn bad_eddy_current_input_is_refused_with_located_errors() {
             format!(
                 "epoch: 2031-01-01T00:00:00Z\n{base}{orbit}effectors:\n  - eddy_currents: {sphere}\n"
             ),
-            "field `epoch`: the magnetic field model (IGRF-14 dipole) covers 1965 to 2030",
+            "field `epoch`: the magnetic field model, IGRF-14 (`magnetic_field: igrf`, the default), covers 1900 to 2030",
         ),
     ];
     for (yaml, expect) in cases {

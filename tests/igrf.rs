@@ -453,3 +453,51 @@ fn the_field_is_continuous_through_the_poles() {
         }
     }
 }
+
+/// The field along an orbit, tabulated once per run (`orbit::field_table`), against the
+/// harmonics summed at the same instants: at 4000 times spread over two days, between and
+/// away from the check points the table was built on, for a low circular orbit in the
+/// degree-13 era and an eccentric one (perigee 500 km, apogee 20 000 km) in the degree-10 era.
+#[test]
+fn the_field_along_an_orbit_is_the_harmonics_within_a_picotesla() {
+    use polhode::orbit::field_table::{FieldTable, TOLERANCE, igrf_on_orbit};
+    use polhode::orbit::{CentralBody, Elements, Orbit};
+    let low = Elements::new(6878.137e3, 0.0, 97.4f64.to_radians(), 0.7, 0.0, 0.3);
+    let (rp, ra) = (6378.137e3 + 500e3, 6378.137e3 + 20_000e3);
+    let eccentric = Elements::new(
+        0.5 * (rp + ra),
+        (ra - rp) / (ra + rp),
+        63.4f64.to_radians(),
+        1.1,
+        4.7,
+        0.0,
+    );
+    // 2027-03-01 and mid-1960 (Unix ns).
+    for (elements, epoch, name) in [
+        (low, 1_803_945_600_000_000_000_i64, "500 km, 97.4°, 2027"),
+        (
+            eccentric,
+            -299_203_200_000_000_000,
+            "500 × 20 000 km, 63.4°, 1960",
+        ),
+    ] {
+        let orbit = Orbit::new(CentralBody::EARTH, elements, true).unwrap();
+        let duration = 2.0 * 86_400.0;
+        let table = FieldTable::build(&orbit, epoch, duration).unwrap().unwrap();
+        let mut worst: f64 = 0.0;
+        for k in 0..4000 {
+            let t = duration * ((k as f64 * 0.618_033_988_749_895) % 1.0);
+            let exact = igrf_on_orbit(&orbit, epoch, t).unwrap();
+            worst = worst.max((table.field_eci(t).unwrap() - exact).amax());
+        }
+        println!(
+            "{name}: {} segments, largest departure {:.2e} nT (checked at build: {:.2e} nT)",
+            table.len(),
+            worst * 1e9,
+            table.max_error() * 1e9
+        );
+        assert!(worst < TOLERANCE, "{name}: {worst:e} T");
+        assert!(table.max_error() < TOLERANCE);
+        assert!(table.field_eci(duration + 1.0).is_none());
+    }
+}

@@ -220,15 +220,27 @@ fn bad_magnetic_input_is_refused_with_located_errors() {
         ),
         (
             format!(
-                "epoch: 1950-01-01T00:00:00Z\n{base}{orbit}effectors:\n  - magnetic_dipole: {{moment: [0.1, 0, 0]}}\n"
+                "epoch: 1950-01-01T00:00:00Z\n{base}orbit: {{semi_major_axis_km: 7000, magnetic_field: dipole}}\neffectors:\n  - magnetic_dipole: {{moment: [0.1, 0, 0]}}\n"
             ),
-            "mag.yaml:1:8: field `epoch`:",
+            "mag.yaml:1:8: field `epoch`: the magnetic field model, IGRF-14 dipole (`magnetic_field: dipole`), covers 1965 to 2030, and the run spans 1950.00 to 1950.00: choose an epoch and duration in that range, or `magnetic_field: igrf` (1900 to 2030)",
+        ),
+        (
+            format!(
+                "epoch: 1899-06-01T00:00:00Z\n{base}{orbit}effectors:\n  - magnetic_dipole: {{moment: [0.1, 0, 0]}}\n"
+            ),
+            "mag.yaml:1:8: field `epoch`: `1899-06-01T00:00:00Z` is before 1900-01-01",
         ),
         (
             format!(
                 "epoch: 2031-01-01T00:00:00Z\n{base}{orbit}effectors:\n  - magnetic_dipole: {{moment: [0.1, 0, 0]}}\n"
             ),
-            "field `epoch`: the magnetic field model (IGRF-14 dipole) covers 1965 to 2030, and the epoch is 2031.00",
+            "field `epoch`: the magnetic field model, IGRF-14 (`magnetic_field: igrf`, the default), covers 1900 to 2030, and the run spans 2031.00 to 2031.00",
+        ),
+        (
+            format!(
+                "{base}orbit: {{semi_major_axis_km: 7000, magnetic_field: wmm}}\neffectors:\n  - magnetic_dipole: {{moment: [0.1, 0, 0]}}\n"
+            ),
+            "field `orbit.magnetic_field`: expected `igrf` (IGRF-14 to degree 13, 1900 to 2030) or `dipole` (its first degree, 1965 to 2030), got `wmm`",
         ),
     ];
     for (yaml, expect) in cases {

@@ -43,6 +43,9 @@ struct Summary<'a> {
     /// Why `auto` picked the method (absent when it was named).
     #[serde(skip_serializing_if = "Option::is_none")]
     method_choice: Option<&'a str>,
+    /// The geomagnetic field model the magnetic effectors see (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    magnetic_field: Option<&'a str>,
     body: Body,
     status: &'a Status,
     mcap: Option<String>,
@@ -163,6 +166,7 @@ pub fn summary_json(s: &Scenario, o: &Outcome, mcap: Option<&Path>) -> String {
         method: s.method.name(),
         method_settings: s.method.describe(),
         method_choice: s.method_choice.as_deref(),
+        magnetic_field: s.magnetic_field.as_deref(),
         body: body(s),
         status: &o.status,
         mcap: mcap.map(|p| p.display().to_string()),
@@ -223,6 +227,9 @@ pub(super) fn print_summary(s: &Scenario, o: &Outcome, mcap: Option<&Path>) {
     }
     if let Some(line) = hub_remainder_line(s) {
         println!("{line}");
+    }
+    if let Some(field) = &s.magnetic_field {
+        println!("  magnetic field: {field}");
     }
     println!(
         "  status: {}{}",

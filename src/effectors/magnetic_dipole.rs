@@ -25,9 +25,7 @@ use std::sync::Arc;
 /// integrated attitude `q` (w, x, y, z; body → inertial; normalised here).
 #[inline]
 pub fn field_body(orbit: &Orbit, field: &GeomagneticField, t: f64, q: &[f64]) -> Vector3<f64> {
-    let (r_hat, radius) = orbit.direction(t);
-    let b_n = field.field_eci(t, &r_hat, radius);
-    to_body(q, &b_n)
+    to_body(q, &field.field_on_orbit(orbit, t))
 }
 
 /// A constant magnetic dipole moment on the hub in the Earth's field.

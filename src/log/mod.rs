@@ -487,6 +487,9 @@ impl<'a> McapLogger<'a> {
         }
         meta.insert("integrator".into(), method.into());
         meta.insert("epoch".into(), format_epoch(scenario.epoch_unix_ns));
+        if let Some(field) = &scenario.magnetic_field {
+            meta.insert("magnetic_field".into(), field.clone());
+        }
         if scenario.epoch_unix_ns < 0 {
             // MCAP log times are unsigned: an epoch before 1970 is stamped from 1970.
             meta.insert("log_time_origin".into(), format_epoch(self.epoch_ns as i64));

@@ -25,8 +25,11 @@
 //! coefficients are linear in time, as the IGRF defines them; after 2025.0 they follow the
 //! secular variation. Time is the decimal calendar year of UTC.
 
+use super::Orbit;
 use super::earth_rotation_angle;
+use super::field_table::{FieldTable, igrf_eci};
 use nalgebra::Vector3;
+use std::sync::Arc;
 
 /// The IGRF reference radius `a` (m): the mean Earth radius of the IGRF potential (not the
 /// WGS-84 equatorial radius).
@@ -143,18 +146,45 @@ pub fn decimal_year(unix_s: f64) -> f64 {
     year as f64 + (unix_s - start) / length
 }
 
-/// The geomagnetic dipole field along a run: IGRF-14 coefficients at the scenario epoch
-/// plus `t`, rotated from ECEF to ECI by the Earth rotation angle.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Which model of the main field a run uses.
+#[derive(Debug, Clone)]
+pub enum FieldModel {
+    /// The first-degree IGRF-14 (a tilted dipole), 1965–2030.
+    Dipole,
+    /// IGRF-14 to degree 13, 1900–2030: along the run's orbit from `table` where it has one
+    /// (tabulated once, [`FieldTable`]), from the harmonics otherwise.
+    Igrf {
+        /// The field along the run's orbit.
+        table: Option<Arc<FieldTable>>,
+    },
+}
+
+/// The geomagnetic field along a run: IGRF-14 at the scenario epoch plus `t`, rotated from
+/// ECEF to ECI by the Earth rotation angle, as a dipole or to degree 13.
+#[derive(Debug, Clone)]
 pub struct GeomagneticField {
     /// The scenario epoch (Unix ns, UTC) of simulation time 0.
     pub epoch_unix_ns: i64,
+    /// The model.
+    pub model: FieldModel,
 }
 
 impl GeomagneticField {
-    /// The field for a run starting at `epoch_unix_ns`.
+    /// The dipole field for a run starting at `epoch_unix_ns`.
     pub fn new(epoch_unix_ns: i64) -> GeomagneticField {
-        GeomagneticField { epoch_unix_ns }
+        GeomagneticField {
+            epoch_unix_ns,
+            model: FieldModel::Dipole,
+        }
+    }
+
+    /// The degree-13 field for a run starting at `epoch_unix_ns`, along the run's orbit from
+    /// `table` where given.
+    pub fn igrf(epoch_unix_ns: i64, table: Option<Arc<FieldTable>>) -> GeomagneticField {
+        GeomagneticField {
+            epoch_unix_ns,
+            model: FieldModel::Igrf { table },
+        }
     }
 
     /// The decimal year at `t` s after the epoch.
@@ -162,18 +192,60 @@ impl GeomagneticField {
         decimal_year(self.epoch_unix_ns as f64 * 1e-9 + t)
     }
 
-    /// The Gauss vector `g` (T) in ECI components at `t`: `R3(−θ) g_ECEF`, θ the Earth
-    /// rotation angle ([`earth_rotation_angle`]).
+    /// The first and last years its model covers.
+    pub fn years(&self) -> (f64, f64) {
+        match self.model {
+            FieldModel::Dipole => (FIRST_YEAR, LAST_YEAR),
+            FieldModel::Igrf { .. } => (super::igrf::FIRST_YEAR, super::igrf::LAST_YEAR),
+        }
+    }
+
+    /// The dipole's Gauss vector `g` (T) in ECI components at `t`: `R3(−θ) g_ECEF`, θ the
+    /// Earth rotation angle ([`earth_rotation_angle`]).
     pub fn gauss_vector_eci(&self, t: f64) -> Vector3<f64> {
         let g = Dipole::igrf14(self.year(t)).gauss_vector();
         let (s, c) = earth_rotation_angle(self.epoch_unix_ns, t).sin_cos();
         Vector3::new(c * g.x - s * g.y, s * g.x + c * g.y, g.z)
     }
 
-    /// The field (T, ECI) at `t` at the unit position `r_hat` (ECI) and distance `radius` (m).
+    /// The field (T, ECI) at `t` at the unit position `r_hat` (ECI) and distance `radius` (m),
+    /// from the model itself (the harmonics for IGRF; NaN outside its years).
     #[inline]
     pub fn field_eci(&self, t: f64, r_hat: &Vector3<f64>, radius: f64) -> Vector3<f64> {
-        dipole_field(&self.gauss_vector_eci(t), r_hat, radius)
+        match self.model {
+            FieldModel::Dipole => dipole_field(&self.gauss_vector_eci(t), r_hat, radius),
+            FieldModel::Igrf { .. } => igrf_eci(self.epoch_unix_ns, t, &(radius * r_hat))
+                .unwrap_or(Vector3::repeat(f64::NAN)),
+        }
+    }
+
+    /// The field (T, ECI) at `t` at the position of `orbit` (the run's: the table, where
+    /// there is one, was built for it).
+    #[inline]
+    pub fn field_on_orbit(&self, orbit: &Orbit, t: f64) -> Vector3<f64> {
+        if let FieldModel::Igrf { table: Some(table) } = &self.model
+            && let Some(b) = table.field_eci(t)
+        {
+            return b;
+        }
+        let (r_hat, radius) = orbit.direction(t);
+        self.field_eci(t, &r_hat, radius)
+    }
+
+    /// The model in words, for summaries and logs.
+    pub fn describe(&self) -> String {
+        match &self.model {
+            FieldModel::Dipole => "IGRF-14 dipole (degree 1)".into(),
+            FieldModel::Igrf { table: Some(t) } => format!(
+                "IGRF-14 to degree 13, tabulated along the orbit ({} segments, within {:.1e} nT \
+                 of the harmonics)",
+                t.len(),
+                t.max_error() * 1e9
+            ),
+            FieldModel::Igrf { table: None } => {
+                "IGRF-14 to degree 13, from the harmonics at every evaluation".into()
+            }
+        }
     }
 }
 

@@ -28,6 +28,7 @@
 mod body;
 mod earth;
 mod elements;
+pub mod field_table;
 pub mod igrf;
 pub mod kepler;
 pub mod magnetic;

@@ -304,6 +304,10 @@ pub(super) struct Context<'a> {
     pub duration: f64,
     /// The hub's mass (`body.mass`, kg), if given.
     pub hub_mass: Option<f64>,
+    /// `orbit.magnetic_field` and where it is written (None for the default).
+    pub magnetic_model: (super::orbit::MagneticModel, Option<(u32, u32)>),
+    /// The field the first magnetic effector built, shared by the others.
+    pub field: std::cell::RefCell<Option<crate::orbit::GeomagneticField>>,
 }
 
 /// Validates `effectors:` and builds them, in order.
@@ -779,25 +783,53 @@ fn geomagnetic_field(
     cx: &Context,
     item: Option<(u32, u32)>,
 ) -> Result<crate::orbit::GeomagneticField, ScenarioError> {
-    let field = crate::orbit::GeomagneticField::new(cx.epoch_unix_ns);
-    let year = field.year(0.0);
-    use crate::orbit::magnetic::{FIRST_YEAR, LAST_YEAR};
-    if !(FIRST_YEAR..=LAST_YEAR).contains(&year) {
+    use super::orbit::MagneticModel;
+    use crate::orbit::GeomagneticField;
+    if let Some(field) = cx.field.borrow().as_ref() {
+        return Ok(field.clone());
+    }
+    let (model, model_loc) = cx.magnetic_model;
+    let probe = match model {
+        MagneticModel::Dipole => GeomagneticField::new(cx.epoch_unix_ns),
+        MagneticModel::Igrf => GeomagneticField::igrf(cx.epoch_unix_ns, None),
+    };
+    let (first, last) = probe.years();
+    let (start, end) = (probe.year(0.0), probe.year(cx.duration));
+    if !(first..=last).contains(&start) || !(first..=last).contains(&end) {
+        let name = match model {
+            MagneticModel::Dipole => "IGRF-14 dipole (`magnetic_field: dipole`)",
+            MagneticModel::Igrf => "IGRF-14 (`magnetic_field: igrf`, the default)",
+        };
         return Err(ScenarioError::at(
             cx.path,
-            cx.epoch_loc.or(item),
+            cx.epoch_loc.or(model_loc).or(item),
             "epoch",
             format!(
-                "the magnetic field model (IGRF-14 dipole) covers {FIRST_YEAR} to {LAST_YEAR}, \
-                 and the epoch is {year:.2}{}: choose an epoch in that range",
+                "the magnetic field model, {name}, covers {first} to {last}, and the run spans \
+                 {start:.2} to {end:.2}{}: choose an epoch and duration in that range{}",
                 if cx.epoch_loc.is_none() {
-                    " (the default)"
+                    " (the default epoch)"
+                } else {
+                    ""
+                },
+                if model == MagneticModel::Dipole && start >= 1900.0 && end <= 2030.0 {
+                    ", or `magnetic_field: igrf` (1900 to 2030)"
                 } else {
                     ""
                 }
             ),
         ));
     }
+    let field = match (model, &cx.orbit) {
+        (MagneticModel::Igrf, Some(orbit)) => {
+            let table =
+                crate::orbit::field_table::FieldTable::build(orbit, cx.epoch_unix_ns, cx.duration)
+                    .map_err(|e| ScenarioError::at(cx.path, cx.epoch_loc.or(item), "epoch", e))?;
+            GeomagneticField::igrf(cx.epoch_unix_ns, table.map(std::sync::Arc::new))
+        }
+        _ => probe,
+    };
+    *cx.field.borrow_mut() = Some(field.clone());
     Ok(field)
 }
 

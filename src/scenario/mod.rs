@@ -288,6 +288,8 @@ pub struct Scenario {
     pub max_log_mb: f64,
     /// The orbit (`orbit:`), when the scenario has one.
     pub orbit: Option<std::sync::Arc<crate::orbit::Orbit>>,
+    /// The geomagnetic field model its magnetic effectors see, in words (None without one).
+    pub magnetic_field: Option<String>,
 }
 
 impl Scenario {
@@ -317,6 +319,7 @@ impl Scenario {
             montecarlo: None,
             max_log_mb: DEFAULT_MAX_LOG_MB,
             orbit: None,
+            magnetic_field: None,
             simulation,
         }
     }
@@ -1002,6 +1005,7 @@ impl ScenarioFile {
             Some(spec) => Some(orbit::orbit(path, spec, key_location(&source, "orbit"))?),
             None => None,
         };
+        let magnetic_model = orbit::magnetic_model(path, self.orbit.as_ref())?;
         let frame = orbit::initial_frame(path, &self.initial.frame, orbit.is_some())?;
         let (attitude0, omega0) = match (&orbit, frame) {
             (Some(o), orbit::InitialFrame::Lvlh) => orbit::from_lvlh(o, &attitude0, &omega0),
@@ -1134,9 +1138,12 @@ impl ScenarioFile {
             epoch_loc: loc_of(&self.epoch),
             duration,
             hub_mass: mass,
+            magnetic_model,
+            field: std::cell::RefCell::new(None),
         };
         let mut built = effectors::build(&cx, &self.effectors)?;
         let mut warnings = cx.notes.into_inner();
+        let mut field = cx.field.into_inner();
         let (hub, hub_mass, spin_axis, composite_hub) =
             if self.body.composite.as_ref().is_some_and(|c| c.value) {
                 let (hub, mass, offset, effector_mass) = composite_remainder(
@@ -1167,9 +1174,12 @@ impl ScenarioFile {
                         epoch_loc: loc_of(&self.epoch),
                         duration,
                         hub_mass: mass,
+                        magnetic_model,
+                        field: std::cell::RefCell::new(None),
                     };
                     built = effectors::build(&cx, &self.effectors)?;
                     warnings = cx.notes.into_inner();
+                    field = cx.field.into_inner();
                 }
                 let report = CompositeHub {
                     total_mass: self.body.mass.as_ref().map(|m| m.value),
@@ -1295,6 +1305,7 @@ impl ScenarioFile {
             montecarlo: self.montecarlo,
             max_log_mb,
             orbit,
+            magnetic_field: field.map(|f| f.describe()),
         })
     }
 }

@@ -47,6 +47,42 @@ pub struct OrbitSpec {
     /// false).
     #[serde(default)]
     pub j2_secular: Option<bool>,
+    /// The geomagnetic field every magnetic model sees: `igrf` (IGRF-14 to degree 13,
+    /// 1900–2030; the default) or `dipole` (its first degree, 1965–2030).
+    #[serde(default)]
+    pub magnetic_field: Option<Spanned<String>>,
+}
+
+/// The main-field model `orbit.magnetic_field` chooses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MagneticModel {
+    /// IGRF-14 to degree 13.
+    Igrf,
+    /// IGRF-14's first degree.
+    Dipole,
+}
+
+/// `orbit.magnetic_field` (default `igrf`) and where it is written.
+pub(super) fn magnetic_model(
+    path: &Path,
+    spec: Option<&OrbitSpec>,
+) -> Result<(MagneticModel, Option<(u32, u32)>), ScenarioError> {
+    let Some(given) = spec.and_then(|s| s.magnetic_field.as_ref()) else {
+        return Ok((MagneticModel::Igrf, None));
+    };
+    match given.value.as_str() {
+        "igrf" => Ok((MagneticModel::Igrf, loc(given))),
+        "dipole" => Ok((MagneticModel::Dipole, loc(given))),
+        other => Err(ScenarioError::at(
+            path,
+            loc(given),
+            "orbit.magnetic_field",
+            format!(
+                "expected `igrf` (IGRF-14 to degree 13, 1900 to 2030) or `dipole` (its first \
+                 degree, 1965 to 2030), got `{other}`"
+            ),
+        )),
+    }
 }
 
 /// Validates `orbit:` into an orbit; `block` is where the `orbit:` key is written.
