@@ -360,3 +360,38 @@ fn check_and_montecarlo_agree_on_a_long_name() {
     assert!(campaign.file_name().unwrap().len() <= 255);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A hand-typed quaternion (four digits, norm 0.99999) is normalised with a located warning;
+/// one off by more than a thousandth is refused.
+#[test]
+fn a_hand_typed_quaternion_is_normalised_with_a_warning() {
+    let typed = BASE.replace(
+        "initial: {omega: [0.1, 0.0, 1.0]}",
+        "initial: {omega: [0.1, 0.0, 1.0], attitude: {w: 0.7071, x: 0, y: 0.7071, z: 0}}",
+    );
+    let s = polhode::scenario::parse(Path::new("q.yaml"), typed, &Default::default()).unwrap();
+    let q = s.attitude0;
+    assert!(
+        (q.w - std::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15,
+        "{q:?}"
+    );
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("q.yaml:3:45: field `initial.attitude`: the quaternion's norm is 0.99999")
+            && w[0].contains("normalised to {w: 0.707106781, x: 0.000000000, y: 0.707106781"),
+        "{w:?}"
+    );
+    let off = BASE.replace(
+        "initial: {omega: [0.1, 0.0, 1.0]}",
+        "initial: {omega: [0.1, 0.0, 1.0], attitude: {w: 0.7, x: 0, y: 0.7, z: 0}}",
+    );
+    let Err(e) = polhode::scenario::parse(Path::new("q.yaml"), off, &Default::default()) else {
+        panic!("a quaternion of norm 0.99 is refused");
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("field `initial.attitude`: expected a unit quaternion {w, x, y, z} (norm within 1e-3 of 1, then normalised), got norm 0.989949"),
+        "{e}"
+    );
+}

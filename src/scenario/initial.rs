@@ -39,15 +39,24 @@ pub struct QuaternionSpec {
     pub z: f64,
 }
 
+/// Distance of a given quaternion's norm from 1 up to which it is normalised silently
+/// (rounding in digits written out in full).
+pub const QUATERNION_NORM_SILENT: f64 = 1e-6;
+/// Distance of a given quaternion's norm from 1 past which it is refused: a quaternion typed
+/// to four digits, {w: 0.7071, x: 0, y: 0.7071, z: 0}, has norm 0.99999 and is normalised
+/// with a warning; one off by more than a thousandth is more likely a mistake.
+pub const QUATERNION_NORM_REFUSE: f64 = 1e-3;
+
+/// The body rates ω₀ (rad/s), the attitude q₀, and a warning about the attitude as given.
+pub(super) type InitialState = (Vector3<f64>, UnitQuaternion<f64>, Option<ScenarioError>);
+
 impl InitialSpec {
     /// The body rates ω₀ (rad/s) and the attitude q₀ (body → the frame of `frame:`), checked:
-    /// one of `omega` and `omega_rpm`, finite, |ω₀| at most [`MAX_RATE`], and a unit
-    /// quaternion. `source` is the file's text, to place an error about a missing key.
-    pub(super) fn state(
-        &self,
-        path: &Path,
-        source: &str,
-    ) -> Result<(Vector3<f64>, UnitQuaternion<f64>), ScenarioError> {
+    /// one of `omega` and `omega_rpm`, finite, |ω₀| at most [`MAX_RATE`], and a quaternion
+    /// whose norm is within [`QUATERNION_NORM_REFUSE`] of 1 (normalised; a located warning
+    /// past [`QUATERNION_NORM_SILENT`], returned beside). `source` is the file's text, to
+    /// place an error about a missing key.
+    pub(super) fn state(&self, path: &Path, source: &str) -> Result<InitialState, ScenarioError> {
         let err = |l: Option<(u32, u32)>, field: &str, msg: String| {
             ScenarioError::at(path, l, field, msg)
         };
@@ -93,25 +102,45 @@ impl InitialSpec {
                 ));
             }
         };
+        let mut note = None;
         let attitude0 = match &self.attitude {
             None => UnitQuaternion::identity(),
             Some(a) => {
                 let q = Quaternion::new(a.value.w, a.value.x, a.value.y, a.value.z);
                 let n = q.norm();
-                if !q.coords.iter().all(|c| c.is_finite()) || (n - 1.0).abs() > 1e-6 {
+                // Six decimals, trailing zeros dropped: 0.99999, 0.989949, 0.
+                let short = format!("{n:.6}");
+                let short = short.trim_end_matches('0').trim_end_matches('.');
+                if !q.coords.iter().all(|c| c.is_finite())
+                    || (n - 1.0).abs() > QUATERNION_NORM_REFUSE
+                {
                     return Err(err(
                         loc(a),
                         "initial.attitude",
                         format!(
-                            "expected a unit quaternion {{w, x, y, z}} (norm within 1e-6 of 1), \
-                         got norm {n}"
+                            "expected a unit quaternion {{w, x, y, z}} (norm within \
+                             {QUATERNION_NORM_REFUSE:e} of 1, then normalised), got norm {short}"
+                        ),
+                    ));
+                }
+                if (n - 1.0).abs() > QUATERNION_NORM_SILENT {
+                    note = Some(err(
+                        loc(a),
+                        "initial.attitude",
+                        format!(
+                            "the quaternion's norm is {short} (hand-typed digits?): normalised to \
+                             {{w: {:.9}, x: {:.9}, y: {:.9}, z: {:.9}}}",
+                            q.w / n,
+                            q.i / n,
+                            q.j / n,
+                            q.k / n
                         ),
                     ));
                 }
                 UnitQuaternion::from_quaternion(q)
             }
         };
-        Ok((omega0, attitude0))
+        Ok((omega0, attitude0, note))
     }
 }
 

@@ -998,7 +998,7 @@ impl ScenarioFile {
             field: inertia_field,
         } = self.body.hub(path, &source)?;
 
-        let (omega0, attitude0) = self.initial.state(path, &source)?;
+        let (omega0, attitude0, attitude_note) = self.initial.state(path, &source)?;
 
         // The orbit, and the initial state given relative to its LVLH frame.
         let orbit = match &self.orbit {
@@ -1277,6 +1277,7 @@ impl ScenarioFile {
         };
 
         let drift_limits = drift_limits(path, self.checks, &spacecraft)?;
+        warnings.splice(0..0, attitude_note);
 
         Ok(Scenario {
             path: path.to_path_buf(),
