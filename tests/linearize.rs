@@ -482,3 +482,53 @@ fn cli_prints_the_spin_decay_without_an_equilibrium_warning() {
     assert!(json["gyrostat"].is_null());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// An unstable verdict names the mode that decides it: a damper on a line tilted 45° between
+/// the radial and the axial direction, whose spring is too soft for the spin (k/m = 0.25
+/// rad²/s² < Ω²/2, the centrifugal field's share along the line), runs away along it, a real
+/// mode, while the nutation of this major-axis spinner, which the line's axial part damps,
+/// decays (issue 38).
+#[test]
+fn an_unstable_verdict_names_the_mode_that_decides_it() {
+    let yaml = "name: soft
+body: {mass: 5274.4, principal: [1375.7, 1292.5, 1402.4], spin_axis: [0, 0, 1]}
+effectors:
+  - spring_mass_damper: {mass: 52.744, position: [1.0, 0.0, 0.0], direction: [1, 0, 1],
+                         stiffness: 13.186, damping: 105.49}
+initial: {omega: [0.0, 0.0, 1.0]}
+duration: 10.0
+";
+    let lin = lin_of(yaml);
+    assert_eq!(lin.verdict, "unstable");
+    let words = lin.deciding_mode.clone().expect("a deciding mode");
+    println!("{words}");
+    // m ẍ + c ẋ + (k − m Ω²/2) x = 0 on a hub that held its spin: a real root
+    // (−c + √(c² + 4 m (mΩ²/2 − k)))/(2m) = 0.118 1/s; the free hub's reaction moves it by
+    // the mass ratio's order.
+    let held = (-105.49 + (105.49f64.powi(2) + 4.0 * 52.744 * 13.186).sqrt()) / (2.0 * 52.744);
+    assert!(
+        (lin.max_growth_rate - held).abs() < 0.1 * held,
+        "{}",
+        lin.max_growth_rate
+    );
+    assert!(
+        words.starts_with("an effector's own mode grows at +"),
+        "{words}"
+    );
+    assert!(
+        words.contains("(not oscillating); the nutation decays at -"),
+        "{words}"
+    );
+    let nutation = lin.nutation.as_ref().unwrap();
+    assert!(nutation.rate < 0.0);
+    let stable = lin_of(&yaml.replace("stiffness: 13.186", "stiffness: 105.488"));
+    assert_eq!(stable.verdict, "asymptotically stable");
+    assert!(
+        stable
+            .deciding_mode
+            .as_deref()
+            .is_some_and(|d| d.contains("decays at -")),
+        "{:?}",
+        stable.deciding_mode
+    );
+}

@@ -170,6 +170,9 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
         );
     }
     println!("  verdict: {}", lin.verdict);
+    if let Some(d) = &lin.deciding_mode {
+        println!("  decided by: {d}");
+    }
     print_spin_decay_and_gyrostat(lin);
     if let Some(n) = &lin.nutation {
         let what = if n.rate > 0.0 { "grows" } else { "decays" };

@@ -65,6 +65,36 @@ pub struct Mode {
     pub time_constant: Option<f64>,
 }
 
+/// The mode that decides a verdict, in words, with the nutation's rate beside it when the
+/// decider is another mode (an effector's real mode can make a spin unstable while its
+/// nutation decays).
+fn deciding_mode_words(m: &Mode, nutation: Option<&Nutation>) -> String {
+    let what = if m.re > 0.0 { "grows" } else { "decays" };
+    let shape = if m.im.abs() > 0.0 {
+        format!("oscillating at {:.6e} rad/s", m.im.abs())
+    } else {
+        "not oscillating".to_string()
+    };
+    let name = match m.role.as_str() {
+        "nutation" => "the nutation".to_string(),
+        "effector" => "an effector's own mode".to_string(),
+        other => format!("the {other} mode"),
+    };
+    let mut words = format!("{name} {what} at {:+.6e} 1/s ({shape})", m.re);
+    if m.role != "nutation"
+        && let Some(n) = nutation
+    {
+        match n.time_constant {
+            Some(_) => {
+                let nut = if n.rate > 0.0 { "grows" } else { "decays" };
+                words.push_str(&format!("; the nutation {nut} at {:+.6e} 1/s", n.rate));
+            }
+            None => words.push_str("; the nutation neither grows nor decays"),
+        }
+    }
+    words
+}
+
 /// The nutation mode's rate and the energy-sink estimate of it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Nutation {
@@ -126,6 +156,10 @@ pub struct Linearization {
     pub modes: Vec<Mode>,
     /// `unstable`, `asymptotically stable` or `marginally stable (oscillatory)`.
     pub verdict: String,
+    /// The mode that decides the verdict, in words: the fastest-growing one when unstable
+    /// (with the nutation's own rate beside it when another mode decides), the slowest
+    /// decaying one when asymptotically stable; `None` otherwise.
+    pub deciding_mode: Option<String>,
     /// Largest real part among the non-spin modes (1/s).
     pub max_growth_rate: f64,
     /// Predicted time constant of the fastest growth or slowest decay, 1/|max_growth_rate| (s).
@@ -568,6 +602,11 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
         .map(|m| m.re)
         .reduce(f64::max)
         .unwrap_or(0.0);
+    let decider = modes
+        .iter()
+        .filter(|m| m.kind != "spin" && m.kind != "rotor" && m.role != "spin_decay")
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .cloned();
     let degenerate = modes.iter().any(|m| m.kind == "neutral");
     let verdict = if max_growth_rate > zero {
         "unstable"
@@ -660,6 +699,9 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
             .collect(),
         state_names: names,
         modes,
+        deciding_mode: decider
+            .filter(|m| m.re.abs() > zero && !degenerate)
+            .map(|m| deciding_mode_words(&m, nutation.as_ref())),
         verdict: verdict.into(),
         max_growth_rate,
         time_constant: (max_growth_rate.abs() > zero).then(|| 1.0 / max_growth_rate.abs()),
