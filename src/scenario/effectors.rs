@@ -27,6 +27,7 @@ mod magnetorquer;
 mod modal_appendage;
 mod rayleigh;
 mod slosh_pendulum;
+mod slosh_tank;
 mod solar_pressure;
 mod spring_mass_damper;
 mod thruster;
@@ -457,12 +458,7 @@ pub(super) fn build(
                 )?));
             }
             EffectorSpec::SpringMassDamper(s) => {
-                out.push(Box::new(spring_mass_damper::build(
-                    &ck,
-                    cx,
-                    s,
-                    name_of(&s.name),
-                )?));
+                out.push(spring_mass_damper::build(&ck, cx, s, name_of(&s.name))?);
             }
             EffectorSpec::SloshPendulum(s) => {
                 let feed = match s.tank.as_ref().and_then(|t| t.value.drained_by.as_ref()) {
@@ -645,9 +641,9 @@ fn feeding_thruster(
 }
 
 /// A slosh analog derived from a tank is designed in the spin's centrifugal field at t = 0; a
-/// thruster's acceleration is another restoring field, which the dynamics apply to the
-/// pendulum but the analog's frequency and damping do not follow. Warns, at the tank, where
-/// the thrusters' peak acceleration exceeds a tenth of that field.
+/// thruster's acceleration is another restoring field, which the dynamics apply to the analog
+/// (pendulum or spring) but the analog's frequency and damping do not follow. Warns, at the
+/// tank, where the thrusters' peak acceleration exceeds a tenth of that field.
 fn thrust_beside_slosh_analogs(
     cx: &Context,
     specs: &[Spanned<EffectorSpec>],
@@ -676,10 +672,16 @@ fn thrust_beside_slosh_analogs(
             .sum::<f64>();
     let acceleration = peak / mass;
     for (i, spanned) in specs.iter().enumerate() {
-        let EffectorSpec::SloshPendulum(s) = &spanned.value else {
-            continue;
+        let (tank, kind, analog) = match &spanned.value {
+            EffectorSpec::SloshPendulum(s) => {
+                (&s.tank, "slosh_pendulum", "pendulum, but its length")
+            }
+            EffectorSpec::SpringMassDamper(s) => {
+                (&s.tank, "spring_mass_damper", "spring, but its stiffness")
+            }
+            _ => continue,
         };
-        let Some(tank) = &s.tank else { continue };
+        let Some(tank) = tank else { continue };
         let center = Vector3::from(tank.value.center.value) + cx.shift;
         let axis = cx.spin_axis;
         let spin = cx.omega0.dot(&axis);
@@ -688,13 +690,12 @@ fn thrust_beside_slosh_analogs(
             cx.notes.borrow_mut().push(ScenarioError::at(
                 cx.path,
                 loc(&tank.value.center),
-                format!("effectors[{i}].slosh_pendulum.tank"),
+                format!("effectors[{i}].{kind}.tank"),
                 format!(
                     "the slosh analog is derived in the spin's centrifugal field at the tank, \
                      {field:.4} m/s², and {} {} the spacecraft by up to {acceleration:.4} m/s² \
-                     ({:.2} times that): the dynamics apply that field to the pendulum, but its \
-                     length and damping stay the analog's for the spin alone \
-                     (docs/slosh-analogs.md)",
+                     ({:.2} times that): the dynamics apply that field to the {analog} and \
+                     damping stay the analog's for the spin alone (docs/slosh-analogs.md)",
                     names
                         .iter()
                         .map(|n| format!("`{n}`"))

@@ -24,11 +24,10 @@
 //!                                         # the fill as it falls
 //! ```
 
+use super::slosh_tank::{TankSpec, refuse_keys_beside_tank, tank_analog};
 use super::{Check, Context, ScenarioError};
 use crate::effectors::draining_slosh::{DrainingSlosh, FillCurves};
-use crate::effectors::slosh_analog::{
-    Liquid, SPIN_NONUNIFORMITY_MAX, SloshAnalog, SloshWarning, Tank, slosh_analog, spin_field,
-};
+use crate::effectors::slosh_analog::{Liquid, Tank};
 use crate::effectors::slosh_pendulum::{
     SINGULAR_COS_THETA, SloshPendulum, THETA_WARN_DEG, pendulum_frame, pendulum_frame_with_pole,
 };
@@ -76,63 +75,6 @@ pub struct SloshPendulumSpec {
     #[serde(default)]
     pub initial_rates: Option<Spanned<[f64; 2]>>,
 }
-
-/// `tank:` — a tank whose first lateral slosh mode the pendulum stands for.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TankSpec {
-    /// `{sphere: {radius}}` or `{cylinder: {radius, height}}` (m); a cylinder stands with its
-    /// axis along the field, radially outward from the spin axis.
-    pub shape: Spanned<TankShapeSpec>,
-    /// The tank's geometric centre (m, body axes).
-    pub center: Spanned<[f64; 3]>,
-    /// Fill fraction by volume.
-    pub fill: Spanned<f64>,
-    /// The propellant.
-    pub liquid: Spanned<LiquidSpec>,
-    /// The thruster that drains the tank (by name; it has no `tank:` of its own).
-    #[serde(default)]
-    pub drained_by: Option<Spanned<String>>,
-    /// Multiplies the smooth-wall damping of the analog (default 1; baffles raise it).
-    #[serde(default)]
-    pub damping_factor: Option<Spanned<f64>>,
-}
-
-/// The tank's shape.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields, rename_all = "snake_case")]
-pub enum TankShapeSpec {
-    /// A sphere.
-    Sphere {
-        /// Inner radius (m).
-        radius: f64,
-    },
-    /// An upright cylinder with flat ends.
-    Cylinder {
-        /// Inner radius (m).
-        radius: f64,
-        /// Inner height between the ends (m).
-        height: f64,
-    },
-}
-
-/// `liquid:`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LiquidSpec {
-    /// Density (kg/m³).
-    pub density: f64,
-    /// Kinematic viscosity (m²/s).
-    pub kinematic_viscosity: f64,
-    /// Surface tension against the ullage gas (N/m).
-    pub surface_tension: f64,
-}
-
-/// Field non-uniformity across a tank (Ω² R/|g| = R/r_T in a pure spin) past which a tank is
-/// refused: the field then varies by half its value between the centre and the wall, and a
-/// uniform-field analog says nothing reliable (docs/slosh-analogs.md). Between
-/// [`SPIN_NONUNIFORMITY_MAX`] and this, the run is warned.
-const NONUNIFORMITY_REFUSE: f64 = 0.5;
 
 /// Validates a `slosh_pendulum:` entry and builds it; `feed` is the thruster its tank's
 /// `drained_by` names, built without a tank of its own.
@@ -315,126 +257,28 @@ fn draining(
 }
 
 /// The pendulum of a tank's first lateral slosh mode in the centrifugal field of the initial
-/// spin: the field at the tank's centre is Ω² r_T, radially outward from the spin axis (through
-/// the hub's centre of mass), and the analog's axis is that direction.
+/// spin ([`tank_analog`]): it hangs radially outward from the spin axis.
 fn from_tank(
     ck: &Check,
     cx: &Context,
     spec: &SloshPendulumSpec,
     tank: &Spanned<TankSpec>,
 ) -> Result<(SloshPendulum, TankSetting), ScenarioError> {
-    for (given, key) in [
-        (spec.mass.is_some(), "mass"),
-        (spec.length.is_some(), "length"),
-        (spec.pivot.is_some(), "pivot"),
-        (spec.rest_direction.is_some(), "rest_direction"),
-        (spec.damping.is_some(), "damping"),
-    ] {
-        if given {
-            return Err(ck.err(
-                tank,
-                "tank",
-                format!(
-                    "`{key}` and `tank` are both given: with a tank, the pendulum's mass, \
-                     length, pivot, rest direction and damping follow from it; remove `{key}`, \
-                     or the tank"
-                ),
-            ));
-        }
-    }
-    let t = &tank.value;
-    let shape = match t.shape.value {
-        TankShapeSpec::Sphere { radius } => Tank::Sphere { radius },
-        TankShapeSpec::Cylinder { radius, height } => Tank::Cylinder { radius, height },
-    };
-    let liquid = Liquid {
-        density: t.liquid.value.density,
-        kinematic_viscosity: t.liquid.value.kinematic_viscosity,
-        surface_tension: t.liquid.value.surface_tension,
-    };
-    let center = ck.on_body(&t.center, "tank.center", "the tank's centre", cx)? + cx.shift;
-    let axis = cx.spin_axis;
-    let spin = cx.omega0.dot(&axis);
-    let outward = center - center.dot(&axis) * axis;
-    let distance = outward.norm();
-    let radius = shape.radius();
-    let field = spin_field(spin, distance, 0.0, radius).map_err(|e| {
-        ck.err(
-            &t.center,
-            "tank.center",
-            format!(
-                "{e}: the tank's centre is {distance:.4} m from the spin axis and the initial \
-                 spin is {spin:.6} rad/s; the analog needs the centrifugal field of a spin \
-                 about an axis the tank is off"
-            ),
-        )
-    })?;
-    if field.nonuniformity > NONUNIFORMITY_REFUSE {
-        return Err(ck.err(
-            &t.center,
-            "tank.center",
-            format!(
-                "the centrifugal field changes by {:.0}% across the tank (radius {radius} m at \
-                 {distance:.4} m from the spin axis); the pendulum analog assumes a uniform \
-                 field, and past {:.0}% it no longer describes the liquid \
-                 (docs/slosh-analogs.md): a tank on or near the spin axis needs another model",
-                100.0 * field.nonuniformity,
-                100.0 * NONUNIFORMITY_REFUSE
-            ),
-        ));
-    }
-    if field.nonuniformity > SPIN_NONUNIFORMITY_MAX {
-        cx.notes.borrow_mut().push(ck.err(
-            &t.center,
-            "tank.center",
-            format!(
-                "slosh analog: the centrifugal field changes by {:.0}% across the tank (R/r_T); \
-                 the uniform-field analog is accurate to a few percent up to {:.0}% \
-                 (docs/slosh-analogs.md), so expect its frequency and damping to be off by \
-                 more here",
-                100.0 * field.nonuniformity,
-                100.0 * SPIN_NONUNIFORMITY_MAX
-            ),
-        ));
-    }
-    let analog: SloshAnalog = slosh_analog(&shape, t.fill.value, &liquid, field.acceleration)
-        .map_err(|e| {
-            let (at, key) = match e {
-                crate::effectors::slosh_analog::SloshError::FillOutOfRange { .. } => {
-                    (super::loc(&t.fill), "tank.fill")
-                }
-                _ => (super::loc(tank), "tank"),
-            };
-            ScenarioError::at(cx.path, at, format!("{}.{key}", ck.prefix), e.to_string())
-        })?;
-    let down = outward / distance;
-    for w in &analog.warnings {
-        let text = match w {
-            SloshWarning::BondMarginal { bond } => format!(
-                "Bond number {bond:.1}: surface tension raises the slosh frequency by a few \
-                 percent, which the gravity analog leaves out"
-            ),
-            SloshWarning::ShallowLiquid { depth_ratio } => format!(
-                "shallow liquid (h/R = {depth_ratio:.3}): the analog's damping correlation is \
-                 least certain here"
-            ),
-        };
-        cx.notes
-            .borrow_mut()
-            .push(ck.err(tank, "tank", format!("slosh analog: {text}")));
-    }
-    let coriolis = analog.coriolis_ratio(spin);
-    if coriolis > 1.0 {
-        cx.notes.borrow_mut().push(ck.err(
-            tank,
-            "tank",
-            format!(
-                "slosh analog: the Coriolis acceleration on the liquid is {coriolis:.2} times \
-                 its restoring one (2Ω/ω₁); the uniform-field pendulum leaves the liquid's own \
-                 Coriolis coupling out"
-            ),
-        ));
-    }
+    refuse_keys_beside_tank(
+        ck,
+        tank,
+        &[
+            (spec.mass.is_some(), "mass"),
+            (spec.length.is_some(), "length"),
+            (spec.pivot.is_some(), "pivot"),
+            (spec.rest_direction.is_some(), "rest_direction"),
+            (spec.damping.is_some(), "damping"),
+        ],
+        "the pendulum's mass, length, pivot, rest direction and damping",
+    )?;
+    let derived = tank_analog(ck, cx, tank, "pendulum")?;
+    let (analog, center, down) = (&derived.analog, derived.center, derived.down);
+    let radius = derived.shape.radius();
     // Heights are along "up", against the field. The pole is tangential to the spin unless
     // given: a spin that moves toward another body axis (a flat spin) swings the rod in the
     // plane of the spin axis and the tank, away from it.
@@ -444,12 +288,9 @@ fn from_tank(
             down,
             ck.perpendicular(pole, "pole", &down, "the tank's field direction")?,
         ),
-        None => pendulum_frame_with_pole(down, axis.cross(&down).normalize()),
+        None => pendulum_frame_with_pole(down, derived.tangential()),
     };
-    let damping_factor = match &t.damping_factor {
-        Some(f) => ck.non_negative(f, "tank.damping_factor", "× the smooth-wall damping")?,
-        None => 1.0,
-    };
+    let damping_factor = derived.damping_factor;
     let model = SloshPendulum {
         mass: analog.slosh_mass,
         length: analog.pendulum_length,
@@ -463,11 +304,11 @@ fn from_tank(
         ),
     };
     let setting = TankSetting {
-        shape,
+        shape: derived.shape,
         center,
         damping_factor,
-        liquid,
-        field: field.acceleration,
+        liquid: derived.liquid,
+        field: derived.field,
     };
     Ok((model, setting))
 }
