@@ -51,11 +51,12 @@ use std::f64::consts::PI;
 /// below 1e-5 for the degree-13 terms (τ ≳ 70 s in low orbit).
 pub const FIELD_STEP: f64 = 0.5;
 
-/// Flatley & Henretty's recoil slope q₀ by default (the slope just after a reversal, as a
-/// fraction of the limiting slope).
+/// The recoil slope q₀ by default (the slope just after a reversal, as a fraction of the
+/// limiting slope): the value of a public restatement of the model, not checked against the
+/// paper (another restatement uses 0.085 with p = 4.75; docs/effectors.md).
 pub const DEFAULT_Q0: f64 = 0.0;
 
-/// Flatley & Henretty's exponent p by default.
+/// The exponent p by default (as [`DEFAULT_Q0`]).
 pub const DEFAULT_P: f64 = 2.0;
 
 /// The rod's hysteresis loop (apparent properties) and the minor-loop rule.
