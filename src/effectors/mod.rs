@@ -10,6 +10,8 @@
 //! - [`GravityGradient`]: the central body's gravity-gradient torque on the hub in orbit.
 //! - [`MagneticDipole`]: a constant magnetic dipole moment in the Earth's field (IGRF dipole).
 //! - [`EddyCurrents`]: eddy-current damping of a conducting body by its magnetic tensor.
+//! - [`HysteresisRod`]: a soft-magnetic rod whose flux density follows the field along it
+//!   through a hysteresis loop (Flatley & Henretty), damping the body's motion in the field.
 //! - [`Magnetorquer`]: coils commanded by a discrete B-dot detumbling law, saturated per axis.
 //! - [`MotorWheel`]: a driven rotor (free, torque profile, speed hold, or rate damping).
 //! - [`SolarPressure`]: solar radiation pressure on a flat plate, with the Earth's shadow.
@@ -30,6 +32,7 @@ pub mod energy_sink;
 pub mod environment;
 pub mod gravity_gradient;
 pub mod hinged_rod;
+pub mod hysteresis_rod;
 pub mod magnetic_dipole;
 pub mod magnetorquer;
 pub mod modal;
@@ -55,6 +58,7 @@ pub use eddy_currents::EddyCurrents;
 pub use energy_sink::EnergySink;
 pub use gravity_gradient::GravityGradient;
 pub use hinged_rod::{HingeFreedom, HingedRod};
+pub use hysteresis_rod::HysteresisRod;
 pub use magnetic_dipole::MagneticDipole;
 pub use magnetorquer::Magnetorquer;
 pub use modal::ModalBeam;

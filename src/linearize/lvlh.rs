@@ -28,9 +28,10 @@ type C64 = Complex<f64>;
 
 /// Effector kinds whose torque varies around the orbit in LVLH (the magnetic field, the Sun
 /// direction, the co-rotating wind), so that no LVLH-fixed attitude is an equilibrium.
-const FORCED: [&str; 4] = [
+const FORCED: [&str; 5] = [
     "magnetic_dipole",
     "eddy_currents",
+    "hysteresis_rod",
     "solar_pressure",
     "aerodynamic",
 ];

@@ -371,6 +371,39 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
                 "J",
             );
         }
+        ("hysteresis_rod", "b") => {
+            return fixed(
+                "Flux density of the rod along its axis (apparent loop)",
+                "T",
+            );
+        }
+        ("hysteresis_rod", "h") => {
+            return fixed("Applied field along the rod, H = ê·B/μ0", "A/m");
+        }
+        ("hysteresis_rod", "h_rate") => {
+            return fixed("Rate of the applied field along the rod, dH/dt", "A/(m s)");
+        }
+        ("hysteresis_rod", "moment") => {
+            return fixed(
+                "Magnetic moment of the rod along its axis, (B/μ0 − H) V",
+                "A m^2",
+            );
+        }
+        ("hysteresis_rod", "torque_x") => {
+            return fixed("Hysteresis-rod torque m × B on the hub, body x", "N m");
+        }
+        ("hysteresis_rod", "torque_y") => {
+            return fixed("Hysteresis-rod torque m × B on the hub, body y", "N m");
+        }
+        ("hysteresis_rod", "torque_z") => {
+            return fixed("Hysteresis-rod torque m × B on the hub, body z", "N m");
+        }
+        ("hysteresis_rod", "work") => {
+            return fixed(
+                "Work done by the hysteresis-rod torque since the start",
+                "J",
+            );
+        }
         ("magnetorquer", "dipole_x") => {
             return fixed("Commanded coil dipole, held between ticks, body x", "A m^2");
         }

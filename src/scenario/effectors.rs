@@ -22,6 +22,7 @@ mod energy_sink;
 mod gravity_gradient;
 mod hinged_rod;
 mod hub_motion;
+mod hysteresis_rod;
 mod magnetic_dipole;
 mod magnetorquer;
 mod modal_appendage;
@@ -39,6 +40,7 @@ use eddy_currents::EddyCurrentsSpec;
 use energy_sink::EnergySinkSpec;
 use gravity_gradient::GravityGradientSpec;
 use hinged_rod::HingedRodSpec;
+use hysteresis_rod::HysteresisRodSpec;
 use magnetic_dipole::MagneticDipoleSpec;
 use magnetorquer::MagnetorquerSpec;
 use modal_appendage::ModalSpec;
@@ -81,6 +83,8 @@ pub enum EffectorSpec {
     MagneticDipole(MagneticDipoleSpec),
     /// Eddy-current damping of a conducting body in the Earth's field (needs `orbit:`).
     EddyCurrents(EddyCurrentsSpec),
+    /// A hysteresis rod in the Earth's field (needs `orbit:`).
+    HysteresisRod(HysteresisRodSpec),
     /// Magnetorquer coils under B-dot control (needs `orbit:`).
     Magnetorquer(Box<MagnetorquerSpec>),
     /// Solar radiation pressure on a flat plate (needs `orbit:`).
@@ -336,6 +340,7 @@ pub(super) fn build(
             EffectorSpec::GravityGradient(_) => "gravity_gradient",
             EffectorSpec::MagneticDipole(_) => "magnetic_dipole",
             EffectorSpec::EddyCurrents(_) => "eddy_currents",
+            EffectorSpec::HysteresisRod(_) => "hysteresis_rod",
             EffectorSpec::Magnetorquer(_) => "magnetorquer",
             EffectorSpec::SolarPressure(_) => "solar_pressure",
             EffectorSpec::Aerodynamic(_) => "aerodynamic",
@@ -401,6 +406,17 @@ pub(super) fn build(
                     cx,
                     e,
                     name_of(&e.name),
+                    orbit,
+                    item,
+                )?));
+            }
+            EffectorSpec::HysteresisRod(r) => {
+                let orbit = needs_orbit()?;
+                out.push(Box::new(hysteresis_rod::build(
+                    &ck,
+                    cx,
+                    r,
+                    name_of(&r.name),
                     orbit,
                     item,
                 )?));

@@ -1,0 +1,377 @@
+//! The `hysteresis_rod` effector, checked against what polhode did not produce: the limiting
+//! loop of Flatley & Henretty (NASA CP-3299, 1995) evaluated here from its formula (its
+//! remanence, coercivity and approach to saturation, as traced by the simulated rod), the
+//! kinetic energy a body turning in a constant field loses per turn against the loop's area
+//! times the rod's volume (a quadrature of the limiting loop here), minor loops inside the
+//! major one, and the located refusals.
+mod common;
+
+use nalgebra::{UnitQuaternion, Vector3};
+use polhode::effectors::HysteresisRod;
+use polhode::effectors::eddy_currents::{AmbientField, MU_0};
+use polhode::effectors::hysteresis_rod::HysteresisLoop;
+use polhode::model::Observation;
+use polhode::scenario::{Overrides, parse};
+use polhode::sim::{self, Control, Memory, Status};
+use std::f64::consts::{PI, TAU};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// Apparent coercivity (A/m), remanence and saturation (T) of the rods in these tests.
+const HC: f64 = 12.0;
+const BR: f64 = 0.35;
+const BS: f64 = 0.74;
+/// A 95 mm × 1 mm rod (m³).
+const VOLUME: f64 = 0.25 * PI * 1e-6 * 0.095;
+
+/// The limiting loop, from the paper's formula (not the crate's): the descending branch
+/// when `descending`, else the ascending one.
+fn limiting(h: f64, descending: bool) -> f64 {
+    let k = (PI * BR / (2.0 * BS)).tan() / HC;
+    let shift = if descending { HC } else { -HC };
+    2.0 * BS / PI * (k * (h + shift)).atan()
+}
+
+/// ∮ H dB of the limiting loop between ±`h0` (J/m³): ∫ (B_desc − B_asc) dH over [−h0, h0]
+/// by composite Simpson.
+fn limiting_loop_area(h0: f64) -> f64 {
+    let n = 200_000;
+    let dh = 2.0 * h0 / n as f64;
+    let f = |h: f64| limiting(h, true) - limiting(h, false);
+    let mut s = f(-h0) + f(h0);
+    for i in 1..n {
+        s += f(-h0 + i as f64 * dh) * if i % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    s * dh / 3.0
+}
+
+/// A body (principal inertia diag(0.008, 0.009, 0.01) kg m²) spinning about its z axis at
+/// 0.2 rad/s with one rod along body x, in a uniform field of strength μ₀ `h0` along
+/// inertial x: the rod sees H = h0 cos θ, θ the angle it has turned. Returns the samples
+/// and state vectors (the rod's B is the state after the hub's 7).
+fn spin(h0: f64, duration: f64) -> (Vec<Observation>, Vec<Vec<f64>>) {
+    let yaml = format!(
+        "name: rod\nbody: {{principal: [0.008, 0.009, 0.01]}}\ninitial: {{omega: [0, 0, 0.2]}}\n\
+         duration: {duration}\nintegrator: {{method: dop853, rtol: 1.0e-12, atol: 1.0e-15}}\n\
+         output: {{rate: 200}}\n"
+    );
+    let mut s = common::scenario(&yaml);
+    s.simulation
+        .spacecraft
+        .add_effector(Box::new(HysteresisRod {
+            name: "rod".into(),
+            field: AmbientField::Uniform(Vector3::new(MU_0 * h0, 0.0, 0.0)),
+            axis: Vector3::x(),
+            volume: VOLUME,
+            hysteresis: HysteresisLoop::new(HC, BR, BS),
+        }))
+        .unwrap();
+    let mut rec = Memory::with_states();
+    let stop = AtomicBool::new(false);
+    let out = sim::run(
+        &s,
+        &mut rec,
+        Control {
+            interrupt: &stop,
+            progress: None,
+        },
+    )
+    .unwrap();
+    assert_eq!(out.status, Status::Complete);
+    (rec.samples, rec.states)
+}
+
+/// The angle the rod has turned from inertial x (rad, unwrapped over the samples).
+fn angles(samples: &[Observation]) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::with_capacity(samples.len());
+    for o in samples {
+        let q: UnitQuaternion<f64> = o.attitude;
+        let e = q * Vector3::x();
+        let mut a = e.y.atan2(e.x);
+        if let Some(&last) = out.last() {
+            a += TAU * ((last - a) / TAU).round();
+        }
+        out.push(a);
+    }
+    out
+}
+
+/// Linear interpolation of `y` where `x` (increasing between i and i + 1) crosses `at`.
+fn cross(x: &[f64], y: &[f64], at: f64) -> Option<f64> {
+    (0..x.len() - 1)
+        .find(|&i| x[i] <= at && x[i + 1] > at)
+        .map(|i| y[i] + (y[i + 1] - y[i]) * (at - x[i]) / (x[i + 1] - x[i]))
+}
+
+/// Through a saturating cycle (H between ±40 H_c) the rod traces Flatley & Henretty's
+/// limiting loop: B_r at H = 0 on the descending branch, −B_r on the ascending one, B = 0 at
+/// H = ∓H_c, and B at the tips approaches B_s as the formula does.
+#[test]
+fn a_saturating_cycle_traces_the_limiting_loop() {
+    let h0 = 40.0 * HC;
+    let (samples, states) = spin(h0, 100.0);
+    let theta = angles(&samples);
+    let b: Vec<f64> = states.iter().map(|y| y[7]).collect();
+    let h: Vec<f64> = theta.iter().map(|a| h0 * a.cos()).collect();
+    // The second turn: θ from 2π to 4π (the first starts from a demagnetised rod).
+    let turn = |from: f64, to: f64| -> Vec<usize> {
+        (0..theta.len())
+            .filter(|&i| theta[i] >= from && theta[i] <= to)
+            .collect()
+    };
+    let falling = turn(TAU, TAU + PI);
+    let rising = turn(TAU + PI, 2.0 * TAU);
+    let pick = |idx: &[usize], v: &[f64]| idx.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+    // Descending half: H falls; interpolate in −H (increasing).
+    let (hf, bf) = (pick(&falling, &h), pick(&falling, &b));
+    let neg_hf: Vec<f64> = hf.iter().map(|x| -x).collect();
+    let b_at_zero = cross(&neg_hf, &bf, 0.0).unwrap();
+    let neg_bf: Vec<f64> = bf.iter().map(|x| -x).collect();
+    let h_at_b_zero = cross(&neg_bf, &hf, 0.0).unwrap();
+    // Ascending half: H rises.
+    let (hr, br) = (pick(&rising, &h), pick(&rising, &b));
+    let b_at_zero_up = cross(&hr, &br, 0.0).unwrap();
+    let h_at_b_zero_up = cross(&br, &hr, 0.0).unwrap();
+    eprintln!(
+        "descending: B(H=0) = {b_at_zero:.6} T, H(B=0) = {h_at_b_zero:.5} A/m; ascending: \
+         B(H=0) = {b_at_zero_up:.6} T, H(B=0) = {h_at_b_zero_up:.5} A/m"
+    );
+    assert!((b_at_zero / BR - 1.0).abs() < 1e-3, "{b_at_zero}");
+    assert!((b_at_zero_up / -BR - 1.0).abs() < 1e-3, "{b_at_zero_up}");
+    assert!((h_at_b_zero / -HC - 1.0).abs() < 1e-3, "{h_at_b_zero}");
+    assert!((h_at_b_zero_up / HC - 1.0).abs() < 1e-3, "{h_at_b_zero_up}");
+    // At the tips B is the limiting loop's (to the recoil just after the tip), below B_s.
+    let tip = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let expected = limiting(h0, false);
+    eprintln!(
+        "tip: |B| = {tip:.6} T, limiting loop {expected:.6} T, B_s = {BS} T, \
+         B_s − |B| = {:.4e} T",
+        BS - tip
+    );
+    assert!(tip < BS && (tip / expected - 1.0).abs() < 1e-3);
+}
+
+/// In a constant field a body turning with rods only loses, over each full turn (from the
+/// same H on the same branch, so that the rod's moment and field are as they were), exactly
+/// the work of the rod's torque, which is the loop's area times the volume, V ∮ H dB. The
+/// loop traced is the limiting one except just after the tips, where the recoil cuts inside
+/// it by ΔB ~ (4 B_s H_c/π)/(k h0²) over ~H_c: a relative 1e-3 at h0 = 40 H_c.
+#[test]
+fn the_energy_lost_per_turn_is_the_loop_area_times_the_volume() {
+    let h0 = 40.0 * HC;
+    let (samples, _) = spin(h0, 330.0);
+    let theta = angles(&samples);
+    let kinetic: Vec<f64> = samples.iter().map(|o| o.kinetic_energy).collect();
+    let balance0 = samples[0].energy_balance();
+    let worst_balance = samples
+        .iter()
+        .map(|o| (o.energy_balance() - balance0).abs())
+        .fold(0.0, f64::max);
+    let area = limiting_loop_area(h0);
+    let expected = area * VOLUME;
+    let mut losses = Vec::new();
+    let mut n = 1;
+    while let (Some(a), Some(b)) = (
+        cross(&theta, &kinetic, n as f64 * TAU),
+        cross(&theta, &kinetic, (n + 1) as f64 * TAU),
+    ) {
+        losses.push(a - b);
+        n += 1;
+    }
+    eprintln!(
+        "limiting loop area {area:.6} J/m³, V·area = {expected:.6e} J, T0 = {:.4e} J; \
+         worst |Δ(T − W)| = {worst_balance:.2e} J",
+        kinetic[0]
+    );
+    for (i, l) in losses.iter().enumerate() {
+        eprintln!(
+            "turn {}: ΔT = {l:.8e} J, / (V·area) − 1 = {:+.3e}",
+            i + 2,
+            l / expected - 1.0
+        );
+    }
+    assert!(losses.len() >= 8, "{}", losses.len());
+    // The energy balance T − W closes.
+    assert!(worst_balance < 1e-10 * kinetic[0], "{worst_balance:e}");
+    // Each turn loses the same (the loop is rate-independent) …
+    for l in &losses {
+        assert!(
+            (l / losses[0] - 1.0).abs() < 1e-5,
+            "{l:e} vs {:e}",
+            losses[0]
+        );
+        // … the loop's area times the volume.
+        assert!((l / expected - 1.0).abs() < 2e-3, "{l:e} vs {expected:e}");
+    }
+}
+
+/// Turning in fields too weak to saturate the rod (amplitudes 0.6 and 1.5 H_c), it traces
+/// minor loops that stay inside the major (limiting) loop, dissipate (each turn loses
+/// energy) and less than the saturating loop does.
+#[test]
+fn minor_loops_stay_inside_the_major_loop() {
+    let major = limiting_loop_area(40.0 * HC) * VOLUME;
+    for ratio in [0.6, 1.5] {
+        let h0 = ratio * HC;
+        let (samples, states) = spin(h0, 130.0);
+        let theta = angles(&samples);
+        let mut worst: f64 = f64::NEG_INFINITY;
+        for (a, y) in theta.iter().zip(&states) {
+            let h = h0 * a.cos();
+            let b = y[7];
+            worst = worst.max(limiting(h, false) - b).max(b - limiting(h, true));
+        }
+        let kinetic: Vec<f64> = samples.iter().map(|o| o.kinetic_energy).collect();
+        let losses: Vec<f64> = (1..3)
+            .map(|n| {
+                cross(&theta, &kinetic, n as f64 * TAU).unwrap()
+                    - cross(&theta, &kinetic, (n + 1) as f64 * TAU).unwrap()
+            })
+            .collect();
+        eprintln!(
+            "h0 = {ratio} H_c: largest excursion outside the major loop {worst:.3e} T; losses \
+             per turn {:.4e} and {:.4e} J (saturating loop {major:.4e} J)",
+            losses[0], losses[1]
+        );
+        assert!(worst <= 1e-9, "{worst:e}");
+        for l in losses {
+            assert!(l > 0.0 && l < major, "{l:e}");
+        }
+    }
+}
+
+fn refusal(yaml: &str) -> String {
+    parse(
+        Path::new("rod.yaml"),
+        yaml.to_string(),
+        &Overrides::default(),
+    )
+    .expect_err(yaml)
+    .to_string()
+}
+
+#[test]
+fn bad_rod_input_is_refused_with_located_errors() {
+    let base =
+        "name: x\nbody: {principal: [1, 2, 3]}\ninitial: {omega: [0, 0, 0.1]}\nduration: 1\n";
+    let orbit = "orbit: {semi_major_axis_km: 7000}\n";
+    let rod = |extra: &str| {
+        format!(
+            "{{axis: [1, 0, 0], length: 0.095, diameter: 0.001, coercivity: 12, remanence: 0.35, \
+             saturation: 0.74{extra}}}"
+        )
+    };
+    let cases = [
+        (
+            format!("{base}effectors:\n  - hysteresis_rod: {}\n", rod("")),
+            "rod.yaml:6:5: field `effectors[0].hysteresis_rod`: an environmental torque needs \
+             the spacecraft's orbit: add an `orbit:` block (semi_major_axis_km or \
+             perigee/apogee altitudes, inclination_deg, …)"
+                .to_string(),
+        ),
+        (
+            format!(
+                "{base}{orbit}effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], volume: 1e-7, \
+                 coercivity: 12, remanence: 0.74, saturation: 0.74}}\n"
+            ),
+            "field `effectors[0].hysteresis_rod.remanence`: expected a remanence below the \
+             saturation 0.74 T (the loop's k = tan(π B_r/(2 B_s))/H_c needs B_r < B_s), got \
+             0.74 T"
+                .to_string(),
+        ),
+        (
+            format!(
+                "{base}{orbit}effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], volume: 1e-7, \
+                 coercivity: 0, remanence: 0.3, saturation: 0.74}}\n"
+            ),
+            "field `effectors[0].hysteresis_rod.coercivity`: expected a positive value from \
+             1e-12 to 1e12 (A/m), got 0"
+                .to_string(),
+        ),
+        (
+            format!(
+                "{base}{orbit}effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], volume: 1e-7, \
+                 length: 0.1, coercivity: 12, remanence: 0.3, saturation: 0.74}}\n"
+            ),
+            "rod.yaml:7:5: field `effectors[0].hysteresis_rod`: expected either `volume` \
+             (m^3) or `length` and `diameter` (m)"
+                .to_string(),
+        ),
+        (
+            format!(
+                "{base}{orbit}effectors:\n  - hysteresis_rod: {}\n",
+                rod(", minor_loops: {q0: 1.5, p: 2}")
+            ),
+            "field `effectors[0].hysteresis_rod.minor_loops.q0`: expected a recoil slope from \
+             0 to 1, got 1.5"
+                .to_string(),
+        ),
+        (
+            format!(
+                "{base}{orbit}integrator: {{method: exact}}\neffectors:\n  - hysteresis_rod: \
+                 {}\n",
+                rod("")
+            ),
+            "hysteresis_rod".to_string(),
+        ),
+    ];
+    for (yaml, expected) in cases {
+        let got = refusal(&yaml);
+        eprintln!("{got}");
+        assert!(got.contains(&expected), "got: {got}\nexpected: {expected}");
+    }
+}
+
+/// In orbit (IGRF along a 600 km polar orbit, the YAML path): a body starting at rest in
+/// inertial space, where H along the rod first changes only through the field's own change
+/// along the orbit, and a tumbling one: the rod's B sweeps most of the loop within ±B_s, and
+/// T − W holds to 1e-9 of the largest T.
+#[test]
+fn in_orbit_the_field_along_the_orbit_drives_the_rod_and_the_balance_closes() {
+    for omega in ["[0, 0, 0]", "[0.05, -0.03, 0.08]"] {
+        let yaml = format!(
+            "name: rod\nepoch: 2025-06-01T00:00:00Z\norbit: {{semi_major_axis_km: 6978.137, \
+             inclination_deg: 90}}\nbody: {{principal: [0.0017, 0.0018, 0.0019]}}\n\
+             initial: {{omega: {omega}}}\nduration: 5800\n\
+             integrator: {{method: dop853, rtol: 1.0e-11, atol: 1.0e-14}}\noutput: {{rate: 0.1}}\n\
+             effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], length: 0.095, diameter: 0.001, \
+             coercivity: 12, remanence: 0.35, saturation: 0.74}}\n"
+        );
+        let s = common::scenario(&yaml);
+        let mut rec = Memory::with_states();
+        let stop = AtomicBool::new(false);
+        let out = sim::run(
+            &s,
+            &mut rec,
+            Control {
+                interrupt: &stop,
+                progress: None,
+            },
+        )
+        .unwrap();
+        assert_eq!(out.status, Status::Complete);
+        let b: Vec<f64> = rec.states.iter().map(|y| y[7]).collect();
+        let (lo, hi) = b
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                (l.min(*x), h.max(*x))
+            });
+        let t0 = rec
+            .samples
+            .iter()
+            .map(|o| o.kinetic_energy)
+            .fold(0.0, f64::max);
+        let worst = rec
+            .samples
+            .iter()
+            .map(|o| (o.energy_balance() - rec.samples[0].energy_balance()).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "ω0 = {omega}: B from {lo:.4} to {hi:.4} T over one orbit; worst |Δ(T − W)| = \
+             {worst:.2e} J (largest T {t0:.3e} J)"
+        );
+        assert!(lo > -BS && hi < BS);
+        assert!(hi - lo > 0.5, "the rod barely moved: {lo} to {hi}");
+        assert!(worst < 1e-9 * t0, "{worst:e}");
+    }
+}
