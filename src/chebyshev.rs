@@ -110,6 +110,17 @@ impl Chebyshev {
         ]
     }
 
+    /// Σ |c_k| over the last `k` coefficients of the series: for a smooth function, an
+    /// estimate of the interpolant's distance from it (the series has converged when its tail
+    /// is at the function's own noise).
+    pub fn tail(&self, k: usize) -> f64 {
+        let n = self.value.len();
+        self.value[n.saturating_sub(k)..]
+            .iter()
+            .map(|c| c.abs())
+            .sum()
+    }
+
     /// The largest |p(x) − f(x)| over `checks` points (x, f(x)).
     pub fn max_error(&self, checks: &[(f64, f64)]) -> f64 {
         checks
