@@ -384,7 +384,8 @@ impl Effector for DrainingSlosh {
         self.feed.next_kink(t)
     }
     fn scratch_len(&self) -> usize {
-        14
+        // W_k = [g_k, C_k] / M_k for the two swing coordinates, then the dashpot's power.
+        15
     }
     fn couple(&self, hub: &HubState, x: &[f64], c: &mut HubCoupling, scratch: &mut [f64]) {
         let w = hub.omega;
@@ -441,6 +442,7 @@ impl Effector for DrainingSlosh {
                 }
             }
         }
+        scratch[14] = p.pendulum.dissipation_power(&x[..2], &x[2..4]);
         c.translation = true;
     }
     fn derivatives(
@@ -462,10 +464,8 @@ impl Effector for DrainingSlosh {
             }
             dx[2 + k] = s;
         }
-        let (flow, _) = self.feed.mass_flow(hub.t);
-        let f = self.fill(self.liquid_mass(hub.t));
-        dx[4] = self.dissipation_power(f, &x[..4]);
-        dx[5] = -flow;
+        dx[4] = scratch[14];
+        dx[5] = -self.feed.mass_flow(hub.t).0;
     }
     fn momentum(&self, hub: &HubState, x: &[f64]) -> Momentum {
         let w = hub.omega;
