@@ -103,8 +103,8 @@ fn tanks(body: &str, spin: f64, shape: &str, x: f64, fill: f64, extra: &str) -> 
 }
 
 /// The tank's spring oscillates at the analog's ω₁ = √(g κ), g = Ω² r_T, damped at its ζ, in
-/// both directions (tangential and axial, for each of two tanks: four modes), for a sphere
-/// and for a flat-bottomed cylinder standing radially.
+/// both directions (tangential and axial, for each of two tanks: four modes), for a sphere,
+/// a flat-bottomed cylinder and a capsule standing radially.
 #[test]
 fn a_tank_s_spring_oscillates_at_the_analog_s_frequency_in_both_directions() {
     let spin = 5.0;
@@ -119,6 +119,14 @@ fn a_tank_s_spring_oscillates_at_the_analog_s_frequency_in_both_directions() {
             Tank::Cylinder {
                 radius: 0.2,
                 height: 0.5,
+            },
+            0.9,
+        ),
+        (
+            "{capsule: {radius: 0.2, barrel: 0.3}}",
+            Tank::Capsule {
+                radius: 0.2,
+                barrel: 0.3,
             },
             0.9,
         ),

@@ -84,8 +84,8 @@ pub enum Tank {
         height: f64,
     },
     /// A circular cylinder with hemispherical ends (inner radius `radius`, length of the
-    /// straight barrel `barrel` between the hemispheres, m). Not supported: see
-    /// [`SloshError::Unsupported`].
+    /// straight barrel `barrel` between the hemispheres, m), standing with its axis along
+    /// the field; its geometric centre is the middle of the barrel.
     Capsule {
         /// Inner radius R of the barrel and the hemispheres (m).
         radius: f64,
@@ -129,15 +129,31 @@ impl Tank {
         match *self {
             Tank::Sphere { radius } => Ok(radius * sphere_depth_ratio(fill_fraction)),
             Tank::Cylinder { height, .. } => Ok(fill_fraction * height),
-            Tank::Capsule { .. } => Err(SloshError::Unsupported(CAPSULE_UNSUPPORTED)),
+            Tank::Capsule { radius, barrel } => {
+                Ok(radius * capsule_depth_ratio(barrel / radius, fill_fraction))
+            }
         }
     }
 }
 
-/// Why the capsule is refused.
-const CAPSULE_UNSUPPORTED: &str = "a cylinder with hemispherical ends has no closed form, \
-     and its published analog curves (SP-106 ch. 6, Dodge 2000) could not be consulted to \
-     check a computed one; its analog depends on both the fill and the barrel length";
+/// h/R of a capsule (barrel length b = `barrel_ratio` R) filled to volume fraction f. The
+/// lower hemisphere holds the first 2/(4 + 3b) of the volume, the barrel the next
+/// 3b/(4 + 3b); in either dome the sphere's cap relation applies to the liquid (below) or to
+/// the ullage (above), by symmetry.
+pub fn capsule_depth_ratio(barrel_ratio: f64, fill_fraction: f64) -> f64 {
+    let f = fill_fraction.clamp(0.0, 1.0);
+    let sphere = 4.0 / 3.0; // volume of a unit sphere over π
+    let total = sphere + barrel_ratio;
+    let volume = f * total;
+    if volume <= 0.5 * sphere {
+        sphere_depth_ratio(volume / sphere)
+    } else if volume <= 0.5 * sphere + barrel_ratio {
+        1.0 + (volume - 0.5 * sphere)
+    } else {
+        let ullage = (total - volume) / sphere;
+        2.0 + barrel_ratio - sphere_depth_ratio(ullage)
+    }
+}
 
 /// h/R of a sphere filled to volume fraction f: the root in [0, 2] of u² (3 − u) = 4 f.
 /// With u = 1 − v the cubic is v³ − 3v + 2 − 4f = 0, and v = 2 cos θ turns it into
@@ -355,13 +371,20 @@ pub fn slosh_analog(
             sphere_geometry(radius, fill_fraction)?
         }
         Tank::Capsule { radius, barrel } => {
-            check_positive(radius, "the capsule radius must be finite and positive")?;
             if !(barrel.is_finite() && barrel >= 0.0) {
                 return Err(SloshError::InvalidInput(
                     "the capsule barrel length must be finite and not negative",
                 ));
             }
-            return Err(SloshError::Unsupported(CAPSULE_UNSUPPORTED));
+            let (min, max) = capsule_fill_range(barrel / radius);
+            if !(min..=max).contains(&fill_fraction) {
+                return Err(SloshError::FillOutOfRange {
+                    fill_fraction,
+                    min,
+                    max,
+                });
+            }
+            capsule_geometry(radius, barrel, fill_fraction)?
         }
     };
     let damping_ratio = damping_ratio_at_depth(tank, liquid, field, geometry.depth / radius);
@@ -474,6 +497,95 @@ fn sphere_geometry(radius: f64, fill_fraction: f64) -> Result<Geometry, SloshErr
     })
 }
 
+/// Depth of liquid (in tank radii) below the free surface beyond which a capsule's liquid is
+/// cut off by a flat wall for the mode's solution. The mode decays with depth like
+/// e^(−ξ₁ d/R); in a cylinder the cut moves κ by 2 e^(−2ξ₁ d/R) = 8e-7 relative at d = 4R,
+/// below the Ritz tolerance, while deeper domains spoil the polynomial basis's conditioning.
+const CAPSULE_MODE_DEPTH: f64 = 4.0;
+
+/// Height of the free surface above the upper dome's base (in tank radii) beyond which a
+/// capsule's analog is refused: there the Ritz basis, centred on a shrinking surface over a
+/// domain up to 4.6R deep, stops converging (κ moves by 1e-4 to 2e-3 between 24 and 40 terms
+/// at 0.7–0.85R, by at most 4e-5 up to 0.6R, for barrels of 0.3–3R).
+pub const CAPSULE_UPPER_DOME_MAX: f64 = 0.6;
+
+/// Fill fractions over which a capsule's analog is provided: the sphere's lower limit
+/// ([`SPHERE_FILL_RANGE`]) applied to the liquid in the lower dome, and the surface at most
+/// [`CAPSULE_UPPER_DOME_MAX`] up the upper dome.
+pub fn capsule_fill_range(barrel_ratio: f64) -> (f64, f64) {
+    let dome_share = (4.0 / 3.0) / (4.0 / 3.0 + barrel_ratio);
+    let ullage = 1.0 - CAPSULE_UPPER_DOME_MAX; // height of the empty cap, over R
+    let ullage_share = ullage * ullage * (3.0 - ullage) / 4.0; // of a sphere's volume
+    (
+        SPHERE_FILL_RANGE.0 * dome_share,
+        1.0 - ullage_share * dome_share,
+    )
+}
+
+/// Capsule of radius R and barrel b filled to volume fraction f, by the Ritz solution of the
+/// first mode over the liquid within [`CAPSULE_MODE_DEPTH`] of the surface.
+fn capsule_geometry(radius: f64, barrel: f64, fill_fraction: f64) -> Result<Geometry, SloshError> {
+    let b = barrel / radius;
+    let half = 0.5 * b;
+    let u = capsule_depth_ratio(b, fill_fraction);
+    let bottom = -half - 1.0;
+    let surface = bottom + u; // over R, from the capsule's centre
+    let wall = move |z: f64| {
+        let d = if z < -half {
+            z + half
+        } else if z > half {
+            z - half
+        } else {
+            0.0
+        };
+        (1.0 - d * d).max(0.0).sqrt()
+    };
+    // Breaks where the wall's formula changes, over the liquid the mode is solved on.
+    let floor = bottom.max(surface - CAPSULE_MODE_DEPTH);
+    let mut breaks = vec![floor];
+    breaks.extend(
+        [-half, half]
+            .into_iter()
+            .filter(|&z| z > floor && z < surface),
+    );
+    breaks.push(surface);
+    let fine = ritz_first_mode(&wall, &breaks, RITZ_TERMS);
+    let coarse = ritz_first_mode(&wall, &breaks, RITZ_TERMS - 4);
+    let change = ((fine.kappa - coarse.kappa) / fine.kappa)
+        .abs()
+        .max(((fine.slosh_volume - coarse.slosh_volume) / fine.slosh_volume).abs());
+    if change.is_nan() || change > RITZ_TOLERANCE {
+        return Err(SloshError::NotConverged { change });
+    }
+    // Volume and centre of mass of the whole liquid: ∫ π a(z)² (1, z) dz, with a² a
+    // quadratic on each piece (Simpson's rule is exact on z a², a cubic).
+    let mut pieces = vec![bottom];
+    pieces.extend(
+        [-half, half]
+            .into_iter()
+            .filter(|&z| z > bottom && z < surface),
+    );
+    pieces.push(surface);
+    let (mut volume, mut moment) = (0.0, 0.0);
+    for w in pieces.windows(2) {
+        let (z0, z1) = (w[0], w[1]);
+        let zm = 0.5 * (z0 + z1);
+        let area = |z: f64| PI * wall(z).powi(2);
+        volume += (z1 - z0) / 6.0 * (area(z0) + 4.0 * area(zm) + area(z1));
+        moment += (z1 - z0) / 6.0 * (z0 * area(z0) + 4.0 * zm * area(zm) + z1 * area(z1));
+    }
+    Ok(Geometry {
+        volume: volume * radius.powi(3),
+        depth: u * radius,
+        cm_height: moment / volume * radius,
+        kappa: fine.kappa / radius,
+        slosh_fraction: fine.slosh_volume / volume,
+        pivot_height: fine.pivot_height * radius,
+        wall_wave_per_radian: fine.wall_wave_per_radian * radius,
+        numerical_error: change,
+    })
+}
+
 /// Viscous damping ratio of a smooth flat-bottomed cylinder: Mikishev & Dorozhkin's
 /// correlation as given in SP-106 (damping chapter), log decrement
 /// δ = 4.98 √Ga [1 + (0.318/sinh(1.84 h/R)) (1 + (1 − h/R)/cosh(1.84 h/R))], ζ = δ/2π.
@@ -488,14 +600,29 @@ pub fn cylinder_damping_ratio(galileo: f64, depth_ratio: f64) -> f64 {
 /// The viscous damping ratio ζ of the first mode in a smooth (unbaffled) `tank` with `liquid`
 /// at depth ratio h/R `depth_ratio`, in the field `field` (m/s²): the correlations
 /// [`cylinder_damping_ratio`] and Mikishev & Dorozhkin's for the sphere. An empirical fit, with
-/// a kink in its slope at half full for the sphere.
+/// a kink in its slope at half full for the sphere. A capsule, for which no correlation was
+/// found, takes the sphere's: exactly its wetted geometry while the surface is in the lower
+/// dome, held at the half-full value while it is in the barrel (the surface and the wall
+/// near it, where the mode and its boundary layer live, are then the half-full sphere's),
+/// and the sphere's upper branch in the upper dome (docs/slosh-analogs.md).
 pub fn damping_ratio_at_depth(tank: &Tank, liquid: &Liquid, field: f64, depth_ratio: f64) -> f64 {
     let radius = tank.radius();
     match *tank {
         Tank::Cylinder { .. } => {
             cylinder_damping_ratio(galileo_number(liquid, field, radius), depth_ratio)
         }
-        _ => sphere_damping_ratio(liquid, field, radius, depth_ratio),
+        Tank::Sphere { .. } => sphere_damping_ratio(liquid, field, radius, depth_ratio),
+        Tank::Capsule { barrel, .. } => {
+            let b = barrel / radius;
+            let equivalent = if depth_ratio <= 1.0 {
+                depth_ratio
+            } else if depth_ratio <= 1.0 + b {
+                1.0
+            } else {
+                depth_ratio - b
+            };
+            sphere_damping_ratio(liquid, field, radius, equivalent)
+        }
     }
 }
 
@@ -933,6 +1060,118 @@ mod tests {
     }
 
     #[test]
+    fn capsule_depth_inverts_the_volume() {
+        // The liquid's volume up to the depth found, by Simpson's rule on the slice area
+        // π a(z)² of each piece (a quadratic, so exact): independent of the inversion.
+        for &b in &[0.0, 0.7, 2.5] {
+            let total = 4.0 / 3.0 * PI + PI * b;
+            for &f in &[0.0, 0.01, 0.1, 0.2, 0.5, 0.8, 0.95, 1.0] {
+                let u = capsule_depth_ratio(b, f);
+                let area = |z: f64| {
+                    let d = (z - 1.0).min(0.0) + (z - 1.0 - b).max(0.0);
+                    PI * (1.0 - d * d)
+                };
+                let mut cuts = vec![0.0];
+                cuts.extend([1.0, 1.0 + b].into_iter().filter(|&z| z > 0.0 && z < u));
+                cuts.push(u);
+                let v: f64 = cuts
+                    .windows(2)
+                    .map(|w| {
+                        (w[1] - w[0]) / 6.0
+                            * (area(w[0]) + 4.0 * area(0.5 * (w[0] + w[1])) + area(w[1]))
+                    })
+                    .sum();
+                assert!(
+                    (v / total - f).abs() < 1e-13,
+                    "b = {b}, f = {f}: {u} holds {v}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn capsule_is_the_sphere_while_the_liquid_is_in_its_lower_dome() {
+        // Below the barrel the liquid, its wall and its surface are those of a sphere filled
+        // to the same depth, whatever the barrel: every output equal up to the quadrature's
+        // rounding (the capsule's liquid is integrated over a shifted origin); with no
+        // barrel, at every fill. Heights differ by the offset of the centres, b/2.
+        let r = 0.7;
+        for &(b, depth_ratio) in &[(0.0, 0.3), (0.0, 1.0), (0.0, 1.6), (1.5, 0.3), (1.5, 0.95)] {
+            let capsule = Tank::Capsule {
+                radius: r,
+                barrel: b * r,
+            };
+            let sphere_fill = depth_ratio * depth_ratio * (3.0 - depth_ratio) / 4.0;
+            let fill = sphere_fill * (4.0 / 3.0) / (4.0 / 3.0 + b);
+            let c = slosh_analog(&capsule, fill, &WATER, 9.81).unwrap();
+            let s = slosh_analog(&Tank::Sphere { radius: r }, sphere_fill, &WATER, 9.81).unwrap();
+            let shift = -0.5 * b * r;
+            for (name, x, y) in [
+                ("kappa", c.frequency_parameter, s.frequency_parameter),
+                ("slosh mass", c.slosh_mass, s.slosh_mass),
+                ("liquid", c.liquid_mass, s.liquid_mass),
+                ("damping", c.damping_ratio, s.damping_ratio),
+            ] {
+                assert!(
+                    rel(x, y) < 1e-9,
+                    "b = {b}, h/R = {depth_ratio}: {name} {x} vs {y}"
+                );
+            }
+            for (name, x, y) in [
+                ("pivot", c.pivot_height, s.pivot_height + shift),
+                ("cm", c.liquid_cm_height, s.liquid_cm_height + shift),
+                ("fixed", c.fixed_mass_height, s.fixed_mass_height + shift),
+            ] {
+                assert!(
+                    (x - y).abs() < 1e-9 * r,
+                    "b = {b}, h/R = {depth_ratio}: {name}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn deep_capsule_is_the_deep_cylinder() {
+        // Surface 5R up a 6R barrel. The mode is solved over the liquid within 4R of the
+        // surface, which here is all barrel: the solution must be the flat-bottomed cylinder
+        // of depth 4R (closed forms, SP-106 Table 6.1 / Dodge 2000 ch. 2), to the Ritz
+        // basis's accuracy on a 4R-deep domain (measured against the closed form: ~1e-7 in κ
+        // and the pivot, ~3e-6 in m_s; tolerances 1e-6 and 1e-5). And that cylinder is the
+        // deep one to what the cut costs: κ and m_s by 2e^(−8ξ₁) = 8e-7 relative (checked to
+        // 1e-6), the pivot by (2R/ξ₁)/sinh(4ξ₁) = 1.4e-3 R (checked to 1.5e-3 R), the figures
+        // docs/slosh-analogs.md states for a capsule's deep liquid.
+        let (r, b) = (0.4, 6.0);
+        let depth_ratio = 1.0 + 5.0;
+        let dome = 4.0 / 3.0;
+        let fill = (dome / 2.0 + (depth_ratio - 1.0)) / (dome + b);
+        let capsule = Tank::Capsule {
+            radius: r,
+            barrel: b * r,
+        };
+        let a = slosh_analog(&capsule, fill, &WATER, 9.81).unwrap();
+        assert!(rel(a.depth, depth_ratio * r) < 1e-14);
+        let surface = (-0.5 * b - 1.0 + depth_ratio) * r;
+        let cut = 4.0 * r;
+        let (lambda, fraction, length, mass_above_cm) = cylinder_reference(r, cut);
+        let cut_cm = surface - 0.5 * cut;
+        assert!(rel(a.frequency_parameter, lambda) < 1e-6);
+        let cut_mass = WATER.density * PI * r * r * cut * fraction;
+        assert!(
+            rel(a.slosh_mass, cut_mass) < 1e-5,
+            "{} vs {cut_mass}",
+            a.slosh_mass
+        );
+        assert!((a.pivot_height - (cut_cm + mass_above_cm + length)).abs() < 1e-6 * r);
+        let xi = 1.841_183_781_340_659_3;
+        assert!(rel(a.frequency_parameter, xi) < 1e-6);
+        let deep_mass = 2.0 * PI * WATER.density * r.powi(3) / (xi * (xi * xi - 1.0));
+        assert!(rel(a.slosh_mass, deep_mass) < 1e-5);
+        let deep_pivot = surface - r / xi;
+        assert!((a.pivot_height - deep_pivot).abs() < 1.5e-3 * r);
+        assert!((a.pivot_height - deep_pivot).abs() > 1.0e-3 * r);
+    }
+
+    #[test]
     fn sphere_pivot_is_at_the_centre() {
         // Pressure on a spherical wall is normal to it, so every pressure force passes
         // through the centre: the mode's moment about the centre vanishes and the pivot is
@@ -1168,17 +1407,21 @@ mod tests {
             slosh_analog(&sphere, 0.5, &WATER, 0.0),
             Err(SloshError::InvalidInput(_))
         ));
+        // A capsule's range: the domes' share of the volume is 4/10 for b = 2R, so the
+        // sphere's lower limit 0.02 becomes 0.008, and the surface 0.6R up the upper dome
+        // (an empty cap 0.4R high: 0.104 of a sphere) is a fill of 0.958.
+        let capsule = Tank::Capsule {
+            radius: 0.5,
+            barrel: 1.0,
+        };
         assert!(matches!(
-            slosh_analog(
-                &Tank::Capsule {
-                    radius: 0.5,
-                    barrel: 1.0
-                },
-                0.5,
-                &WATER,
-                9.81
-            ),
-            Err(SloshError::Unsupported(_))
+            slosh_analog(&capsule, 0.96, &WATER, 9.81),
+            Err(SloshError::FillOutOfRange { .. })
+        ));
+        assert!(slosh_analog(&capsule, 0.955, &WATER, 9.81).is_ok());
+        assert!(matches!(
+            slosh_analog(&capsule, 0.0079, &WATER, 9.81),
+            Err(SloshError::FillOutOfRange { .. })
         ));
         // Bond number: water in a 0.5 m tank at 1e-4 g has Bo = 998·9.81e-4·0.25/0.0728 =
         // 3.4 (refused); at 2e-3 g, 67 (warned); at 1 g, 33 600 (clean).

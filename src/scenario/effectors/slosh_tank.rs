@@ -5,7 +5,8 @@
 //!
 //! ```yaml
 //! tank:
-//!   shape: {sphere: {radius: 0.25}}   # or {cylinder: {radius: r, height: h}}
+//!   shape: {sphere: {radius: 0.25}}   # or {cylinder: {radius: r, height: h}},
+//!                                     # or {capsule: {radius: r, barrel: b}}
 //!   center: [0.5, 0.0, 0.2]           # m, body axes
 //!   fill: 0.5                         # by volume
 //!   liquid: {density: 1004.0, kinematic_viscosity: 9.0e-7, surface_tension: 0.066}
@@ -26,8 +27,9 @@ use serde_saphyr::Spanned;
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TankSpec {
-    /// `{sphere: {radius}}` or `{cylinder: {radius, height}}` (m); a cylinder stands with its
-    /// axis along the field, radially outward from the spin axis.
+    /// `{sphere: {radius}}`, `{cylinder: {radius, height}}` or `{capsule: {radius, barrel}}`
+    /// (m); a cylinder or capsule stands with its axis along the field, radially outward from
+    /// the spin axis.
     pub shape: Spanned<TankShapeSpec>,
     /// The tank's geometric centre (m, body axes).
     pub center: Spanned<[f64; 3]>,
@@ -59,6 +61,13 @@ pub enum TankShapeSpec {
         radius: f64,
         /// Inner height between the ends (m).
         height: f64,
+    },
+    /// A cylinder with hemispherical ends, standing along the field.
+    Capsule {
+        /// Inner radius of the barrel and the domes (m).
+        radius: f64,
+        /// Length of the straight barrel between the domes (m).
+        barrel: f64,
     },
 }
 
@@ -144,6 +153,7 @@ pub(super) fn tank_analog(
     let shape = match t.shape.value {
         TankShapeSpec::Sphere { radius } => Tank::Sphere { radius },
         TankShapeSpec::Cylinder { radius, height } => Tank::Cylinder { radius, height },
+        TankShapeSpec::Capsule { radius, barrel } => Tank::Capsule { radius, barrel },
     };
     let liquid = Liquid {
         density: t.liquid.value.density,
