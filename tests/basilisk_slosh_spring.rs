@@ -340,3 +340,43 @@ fn tank_spring_agrees_with_basilisk_linear_spring_mass_damper() {
         }
     }
 }
+
+/// `polhode check` prints what the tank gave its spring, in numbers that read back to the
+/// model's own, bit for bit (peers/basilisk_slosh_spring.py builds Basilisk's scene from them).
+#[test]
+fn check_prints_the_derived_spring_exactly() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let file = root.join("peers/slosh_spring.yaml");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_polhode"))
+        .arg("check")
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("  spring_mass_damper tank from its tank: "))
+        .collect();
+    assert_eq!(lines.len(), 1, "{text}");
+    // Every token that reads as a number, in order ("line 1" gives the 1).
+    let printed: Vec<f64> = lines[0]
+        .split([' ', '[', ']', ',', ';'])
+        .filter_map(|t| t.parse().ok())
+        .collect();
+    let s = parse(
+        &file,
+        std::fs::read_to_string(&file).unwrap(),
+        &Overrides::default(),
+    )
+    .unwrap();
+    let m = spring(&s);
+    let sp = &m.spring;
+    let mut want = vec![sp.mass];
+    want.extend(sp.position.iter());
+    want.push(1.0);
+    want.extend(sp.direction.iter());
+    want.extend([sp.stiffness, sp.damping, m.fixed_mass]);
+    want.extend(m.fixed_position.iter());
+    assert_eq!(printed, want, "{}", lines[0]);
+}
