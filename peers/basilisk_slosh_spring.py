@@ -21,7 +21,8 @@ the sloshing mass, its rest point r_PB_B, the direction pHat_B, k, c, and the fi
 and where it sits. The hub then is polhode's hub (body.mass at the origin, body.principal)
 plus the point mass m0: mHub = M + m0, r_BcB_B = m0 r_f / (M + m0), IHubPntBc_B the pair's
 inertia about that point. The script asserts that Basilisk's effector holds exactly these
-numbers and that the system's mass and centre of mass at t = 0 are the scene's.
+numbers and that the hub carries the fixed liquid's mass and first moment. The polhode it calls
+is target/release/polhode (build it first: peers/run.sh does), or $POLHODE.
 
 polhode's two-direction form is one particle with two coordinates. Two linearSpringMassDampers,
 one per line, would be two particles each with its own mass (the liquid counted twice, or
