@@ -47,12 +47,16 @@ if [[ $report_only == 0 ]]; then
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
     "$VENV/bin/python" "$PEERS/basilisk_slosh.py"
+    "$VENV/bin/python" "$PEERS/basilisk_slosh_spring.py"
     "$VENV/bin/python" "$PEERS/basilisk_burn.py"
     "$VENV/bin/python" "$PEERS/basilisk_environment.py"
   fi
   # slosh_pendulum along Basilisk's sphericalPendulum trajectories (results/basilisk_slosh.json).
   echo "[run] polhode's slosh_pendulum against Basilisk's trajectories (tests/basilisk_slosh.rs)"
   (cd "$ROOT" && cargo test --release --locked --quiet --test basilisk_slosh)
+  # the tank's spring_mass_damper along Basilisk's trajectories (results/basilisk_slosh_spring.json).
+  echo "[run] polhode's tank spring against Basilisk's trajectories (tests/basilisk_slosh_spring.rs)"
+  (cd "$ROOT" && cargo test --release --locked --quiet --test basilisk_slosh_spring)
   # polhode's environmental torques at the states of results/basilisk_environment.json.
   echo "[run] polhode's environmental torques at Basilisk's states (tests/basilisk_environment.rs)"
   (cd "$ROOT" && POLHODE_PEER_OUT="$PEERS/results/basilisk_environment_polhode.json" \

@@ -1,6 +1,6 @@
 //! `polhode check`: validation without a run.
 
-use super::summary::hub_remainder_line;
+use super::summary::{hub_remainder_line, tank_spring_lines};
 use super::{EXIT_BAD_INPUT, load};
 use crate::scenario::Overrides;
 use std::path::PathBuf;
@@ -44,6 +44,9 @@ pub(super) fn check(paths: &[PathBuf]) -> i32 {
             s.mcap_path.display()
         );
         if let Some(line) = hub_remainder_line(&s) {
+            println!("{line}");
+        }
+        for line in tank_spring_lines(&s) {
             println!("{line}");
         }
         for w in &s.warnings {

@@ -29,6 +29,46 @@ pub(super) fn hub_remainder_line(s: &Scenario) -> Option<String> {
     ))
 }
 
+/// For each `spring_mass_damper` built from a `tank:`, what polhode derived from the tank, for
+/// `check`: the sloshing mass, its rest point, each line's direction and spring, the dashpot and
+/// the fixed liquid (m, body axes about the hub's centre of mass). The numbers are printed in
+/// the shortest form that reads back to the same f64 (peers/basilisk_slosh_spring.py builds
+/// Basilisk's scene from them).
+pub(super) fn tank_spring_lines(s: &Scenario) -> Vec<String> {
+    use crate::effectors::{ParticleEffector, SloshSpring};
+    let v = |x: &nalgebra::Vector3<f64>| format!("[{:e}, {:e}, {:e}]", x[0], x[1], x[2]);
+    s.spacecraft
+        .effectors()
+        .iter()
+        .filter_map(|e| {
+            let any = e.as_ref() as &dyn std::any::Any;
+            let m = any.downcast_ref::<ParticleEffector<SloshSpring>>()?.model();
+            let sp = &m.spring;
+            let second = match &m.second {
+                Some(l) => format!(
+                    "; line 2 direction {} stiffness {:e} N/m",
+                    v(&l.direction),
+                    l.stiffness
+                ),
+                None => String::new(),
+            };
+            Some(format!(
+                "  spring_mass_damper {} from its tank: sloshing mass {:e} kg at {} m; line 1 \
+                 direction {} stiffness {:e} N/m{second}; damping {:e} N s/m; fixed liquid {:e} \
+                 kg at {} m",
+                e.name(),
+                sp.mass,
+                v(&sp.position),
+                v(&sp.direction),
+                sp.stiffness,
+                sp.damping,
+                m.fixed_mass,
+                v(&m.fixed_position)
+            ))
+        })
+        .collect()
+}
+
 /// Event lines the text summary prints; the rest are counted.
 const PRINTED_EVENTS: usize = 10;
 
