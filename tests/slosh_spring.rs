@@ -327,3 +327,41 @@ fn the_tank_form_refuses_what_it_cannot_stand_for() {
         "{e}"
     );
 }
+
+/// The springs are derived at the initial spin, and the liquid's restoring field (Ω² r_T)
+/// follows the spin while the springs do not: a thruster spinning the stage up is warned past
+/// a 5 % change and stopped past 25 %, with a diagnosis naming both spins. Hub about z (its
+/// major axis) at 5 rad/s; 20 N at 1 m tangentially spin it up at about 0.1 rad/s².
+#[test]
+fn a_spin_change_the_springs_were_not_derived_for_is_warned_then_stopped() {
+    let yaml = format!(
+        "name: t\nbody: {{mass: 500.0, principal: [100.0, 110.0, 200.0], spin_axis: [0, 0, 1]}}\n\
+         initial: {{omega: [0.0, 0.0, 5.0]}}\nduration: 40.0\neffectors:\n\
+         {}\n  - thruster:\n      name: spin_up\n      nozzle: [0.0, 1.0, 0.0]\n      \
+         direction: [-1.0, 0.0, 0.0]\n      thrust: {{constant: 20.0}}\n      isp: 300.0\n      \
+         tank: {{model: point, center: [0, 0, 0], propellant: 5.0}}\n",
+        tanks("", 5.0, "{sphere: {radius: 0.15}}", 0.7, 0.6, "")
+            .split_once("effectors:\n")
+            .unwrap()
+            .1
+            .trim_end()
+    );
+    let s = scenario(&yaml);
+    let (out, _) = run(&s);
+    let Status::InvalidModel { diagnosis } = &out.status else {
+        panic!("expected invalid_model, got {:?}", out.status);
+    };
+    assert!(diagnosis.contains("springs were derived"), "{diagnosis}");
+    let spin = out.final_observation.omega.z;
+    // Stopped at the first accepted step past 25 %: the step is short against the 12 s the
+    // spin-up takes, so the spin is within 2 % of the limit.
+    assert!(
+        (1.25..1.27).contains(&(spin / 5.0)),
+        "stopped at {spin} rad/s"
+    );
+    let warned = out
+        .warnings
+        .iter()
+        .any(|w| format!("{w:?}").contains("springs were derived"));
+    assert!(warned, "no warning: {:?}", out.warnings);
+}

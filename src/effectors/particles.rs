@@ -188,6 +188,15 @@ pub trait ParticleModel: Debug + Send + Sync {
     fn validity_report(&self, _q: &[f64]) -> (String, String) {
         (String::new(), String::new())
     }
+    /// Where it stands at the hub state `hub` and coordinates `q`
+    /// ([`Effector::validity_at`]); the default sees `q` only.
+    fn validity_at(&self, _hub: &HubState, q: &[f64]) -> Option<Validity> {
+        self.validity(q)
+    }
+    /// [`ParticleModel::validity_at`] in words ([`Effector::validity_report_at`]).
+    fn validity_report_at(&self, _hub: &HubState, q: &[f64]) -> (String, String) {
+        self.validity_report(q)
+    }
 }
 
 /// What `couple` needs from the particles' kinematics, summed over them, for at most `N`
@@ -782,6 +791,16 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
     fn validity_report(&self, x: &[f64]) -> (String, String) {
         self.model
             .validity_report(&x[..self.model.num_coordinates()])
+    }
+
+    fn validity_at(&self, hub: &HubState, x: &[f64]) -> Option<Validity> {
+        self.model
+            .validity_at(hub, &x[..self.model.num_coordinates()])
+    }
+
+    fn validity_report_at(&self, hub: &HubState, x: &[f64]) -> (String, String) {
+        self.model
+            .validity_report_at(hub, &x[..self.model.num_coordinates()])
     }
 }
 

@@ -11,7 +11,7 @@
 
 use super::particles::{ParticleModel, ParticlePoint};
 use super::spring_mass::SpringMass;
-use crate::model::{Drawing, Validity};
+use crate::model::{Drawing, HubState, Validity};
 use nalgebra::Vector3;
 
 /// A tank's spring–mass slosh analog.
@@ -29,7 +29,20 @@ pub struct SloshSpring {
     pub fixed_position: Vector3<f64>,
     /// The offset |ρ| (m) past which the analog leaves its small-amplitude range (warned).
     pub amplitude_warning: f64,
+    /// The spin the stiffnesses were derived for: its axis (unit, body axes) and rate Ω₀
+    /// (rad/s). The restoring field Ω² r_T and the across-spin term Ω² both follow the spin,
+    /// the springs do not; `None` for an analog not derived from a spin.
+    pub design_spin: Option<(Vector3<f64>, f64)>,
 }
+
+/// Relative change of the spin from the one a tank's springs were derived for past which the
+/// run warns: the slosh frequency, ∝ Ω, is then off by about as much, the order of the
+/// analog's own accuracy.
+pub const SPIN_CHANGE_WARN: f64 = 0.05;
+
+/// Relative change of the spin past which the run stops: the springs then stand for a
+/// different liquid (frequency off by a quarter or more).
+pub const SPIN_CHANGE_LIMIT: f64 = 0.25;
 
 /// The second line of a [`SloshSpring`].
 #[derive(Debug, Clone)]
@@ -40,7 +53,35 @@ pub struct SecondLine {
     pub stiffness: f64,
 }
 
+/// Of two measures, the one past its limit, else the one past its warning, else `a`.
+fn more_urgent(a: Validity, b: Validity) -> Validity {
+    if a.past_limit() {
+        a
+    } else if b.past_limit() || (b.past_warning() && !a.past_warning()) {
+        b
+    } else {
+        a
+    }
+}
+
 impl SloshSpring {
+    /// The spin rate about the design spin's axis (rad/s; 0 without one).
+    fn spin_rate(&self, hub: &HubState) -> f64 {
+        self.design_spin
+            .map_or(0.0, |(axis, _)| hub.omega.dot(&axis))
+    }
+
+    /// The spin's relative change from the design spin, against [`SPIN_CHANGE_WARN`] and
+    /// [`SPIN_CHANGE_LIMIT`].
+    fn spin_validity(&self, hub: &HubState) -> Option<Validity> {
+        let (_, design) = self.design_spin?;
+        Some(Validity {
+            value: (self.spin_rate(hub) / design - 1.0).abs(),
+            warn: SPIN_CHANGE_WARN,
+            limit: SPIN_CHANGE_LIMIT,
+        })
+    }
+
     /// The sloshing mass's distance from its rest point, |ρ| (m), at coordinates `q`.
     pub fn offset(&self, q: &[f64]) -> f64 {
         match self.second {
@@ -143,6 +184,33 @@ impl ParticleModel for SloshSpring {
                 .into(),
         )
     }
+    fn validity_at(&self, hub: &HubState, q: &[f64]) -> Option<Validity> {
+        let amplitude = self.validity(q);
+        match (self.spin_validity(hub), amplitude) {
+            (Some(spin), Some(amplitude)) => Some(more_urgent(spin, amplitude)),
+            (spin, amplitude) => spin.or(amplitude),
+        }
+    }
+    fn validity_report_at(&self, hub: &HubState, q: &[f64]) -> (String, String) {
+        let (Some(spin), Some(amplitude)) = (self.spin_validity(hub), self.validity(q)) else {
+            return self.validity_report(q);
+        };
+        if more_urgent(spin, amplitude) != spin {
+            return self.validity_report(q);
+        }
+        let (_, design) = self.design_spin.unwrap_or_default();
+        (
+            format!(
+                "the spin is {:.4} rad/s against the {design:.4} rad/s its springs were derived                  for ({:+.1} %): the liquid's restoring field, ∝ Ω², has moved and the springs                  have not (warned past {:.0} %, stopped past {:.0} %)",
+                self.spin_rate(hub),
+                100.0 * (self.spin_rate(hub) / design - 1.0),
+                100.0 * SPIN_CHANGE_WARN,
+                100.0 * SPIN_CHANGE_LIMIT
+            ),
+            "the pendulum form (`slosh_pendulum: {tank: …}`), whose restoring force follows              the spin; or a spring analog derived at the spin of the phase studied"
+                .into(),
+        )
+    }
     fn drawings(&self, q: &[f64]) -> Vec<Drawing> {
         let s = &self.spring;
         let mut drawings = s.drawings(&q[..1]);
@@ -200,6 +268,7 @@ mod tests {
             fixed_mass: 0.0,
             fixed_position: Vector3::zeros(),
             amplitude_warning: 0.01,
+            design_spin: None,
         };
         let a = ParticleEffector::new("a", damper, &[0.0], &[0.0]);
         let b = ParticleEffector::new("b", tank, &[0.0], &[0.0]);

@@ -339,5 +339,6 @@ fn from_tank(
         fixed_position: derived.center + a.fixed_mass_height * up,
         // The pendulum's swing θ moves its mass L θ across: the same wall wave.
         amplitude_warning: a.pendulum_length * a.max_pendulum_angle(WAVE_RATIO, radius),
+        design_spin: Some((cx.spin_axis, spin)),
     })
 }
