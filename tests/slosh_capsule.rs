@@ -55,7 +55,7 @@ fn capsule_analog_matches_the_finite_element_reference() {
         };
         let (min, max) = capsule_fill_range(barrel);
         if !(min..=max).contains(&fill) {
-            // Past the range the Ritz basis is provided for (the surface more than 0.6R up
+            // Past the range the Ritz basis is provided for (the surface more than 0.3R up
             // the upper dome): refused, not answered.
             println!(
                 "barrel {barrel} depth {depth}: fill {fill:.4} refused (range {min:.4}-{max:.4})"
