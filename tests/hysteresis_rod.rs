@@ -64,6 +64,7 @@ fn spin(h0: f64, duration: f64) -> (Vec<Observation>, Vec<Vec<f64>>) {
             axis: Vector3::x(),
             volume: VOLUME,
             hysteresis: HysteresisLoop::new(HC, BR, BS),
+            conductor: None,
         }))
         .unwrap();
     let mut rec = Memory::with_states();
@@ -503,4 +504,46 @@ fn material_properties_through_the_scenario_file() {
         assert!(got.starts_with("rod.yaml:8:"), "{got}");
         assert!(got.contains(expected), "got: {got}\nexpected: {expected}");
     }
+}
+
+/// The eddy currents bound the rate-independent loop: a body spun up about y by a prescribed
+/// motion, from rest to 400 rad/s over 20 s, in a 600 km polar orbit, with a HyMu-80 rod
+/// (material loop, 95 mm × 1 mm) along x: the rod switches when H along it passes ±H_c,
+/// where its dB/dH is the loop's 2kB_s/π and dH/dt ≈ ω H_⊥ (H_⊥ the field across y, 20 to
+/// 45 A/m on this orbit), so σ r² |dB/dt|/4 reaches H_c at ω = 4 H_c π/(σ r² 2kB_s H_⊥),
+/// 124 to 279 rad/s here. The run is warned once and stopped with the diagnosis in that
+/// range (at 226.8 rad/s).
+#[test]
+fn the_rods_eddy_currents_bound_the_model_during_the_run() {
+    let yaml = "name: x\nepoch: 2025-06-01T00:00:00Z\nbody: {principal: [0.002, 0.002, 0.002]}\n\
+                initial: {omega: [0, 0, 0]}\nduration: 20\n\
+                orbit: {semi_major_axis_km: 6978.137, inclination_deg: 90}\n\
+                integrator: {method: dop853, rtol: 1.0e-10, atol: 1.0e-13}\n\
+                hub_motion: {spin_up: {axis: [0, 1, 0], rate: 400.0, ramp_time: 20.0}}\n\
+                effectors:\n  - hysteresis_rod: {axis: [1, 0, 0], length: 0.095, diameter: \
+                0.001, coercivity: 1.59, remanence: 0.35, saturation: 0.73, properties: \
+                material}\n";
+    let s = common::scenario(yaml);
+    let mut rec = Memory::with_states();
+    let stop = AtomicBool::new(false);
+    let control = Control {
+        interrupt: &stop,
+        progress: None,
+    };
+    let out = sim::run(&s, &mut rec, control).unwrap();
+    let Status::InvalidModel { diagnosis } = &out.status else {
+        panic!("{:?}", out.status);
+    };
+    let w = out.final_observation.omega.norm();
+    eprintln!("stopped at |ω| = {w} rad/s: {diagnosis}");
+    assert!(diagnosis.contains("eddy currents"), "{diagnosis}");
+    assert!(diagnosis.contains("limit 1"), "{diagnosis}");
+    // The estimate's range for H_⊥ from 20 to 45 A/m.
+    let a = HysteresisLoop::new(1.59, 0.35, 0.73).apparent(demagnetising_factor(95.0));
+    let slope = 2.0 * a.k() * a.saturation / PI;
+    let per_rate = |h_perp: f64| 0.25 * (1.0 / 0.58e-6) * 0.25e-6 * slope * h_perp / a.coercivity;
+    let (lo, hi) = (1.0 / per_rate(45.0), 1.0 / per_rate(20.0));
+    eprintln!("estimated limit between {lo:.1} and {hi:.1} rad/s");
+    assert!(w > lo && w < hi, "{w} outside [{lo}, {hi}]");
+    assert_eq!(out.warnings.len(), 1, "{:?}", out.warnings);
 }

@@ -42,7 +42,7 @@
 
 use super::eddy_currents::{AmbientField, MU_0};
 use super::environment::{names, to_body};
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Validity};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
@@ -195,6 +195,37 @@ impl HysteresisLoop {
     }
 }
 
+/// The electrical conductivity of HyMu-80 (S/m): the reciprocal of its resistivity, 0.58 µΩ m
+/// (Carpenter Technology's datasheet of the alloy), the default for the rod's eddy currents.
+pub const HYMU80_CONDUCTIVITY: f64 = 1.0 / 0.58e-6;
+
+/// The eddy-current field over the coercivity past which a run is warned (the measure of the
+/// rod's validity).
+pub const EDDY_WARN: f64 = 0.1;
+
+/// The eddy-current field over the coercivity past which the rate-independent loop does not
+/// hold: a run stops (`checks.on_validity`).
+pub const EDDY_LIMIT: f64 = 1.0;
+
+/// The conductor behind a rod's eddy currents, for its validity range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodConductor {
+    /// Radius r (m).
+    pub radius: f64,
+    /// Electrical conductivity σ (S/m).
+    pub conductivity: f64,
+}
+
+impl RodConductor {
+    /// The field (A/m) the eddy currents of a flux density changing at `b_rate` (T/s) set up
+    /// on the rod's axis, against the change: in a long cylinder with a uniform dB/dt along
+    /// it the current density is J(ρ) = σ ρ Ḃ/2 around the axis, and the field at the axis
+    /// ∫₀^r J dρ = σ r² Ḃ/4.
+    pub fn eddy_field(&self, b_rate: f64) -> f64 {
+        0.25 * self.conductivity * self.radius * self.radius * b_rate.abs()
+    }
+}
+
 /// A hysteresis rod on the hub.
 #[derive(Debug, Clone)]
 pub struct HysteresisRod {
@@ -208,6 +239,9 @@ pub struct HysteresisRod {
     pub volume: f64,
     /// Its loop.
     pub hysteresis: HysteresisLoop,
+    /// Its radius and conductivity, for the validity check (`None`: a rod given by its
+    /// volume, unchecked).
+    pub conductor: Option<RodConductor>,
 }
 
 /// What the rod sees at a hub state: the field (T, body axes), H along the rod (A/m) and its
@@ -325,6 +359,39 @@ impl Effector for HysteresisRod {
             work: x[WORK],
             ..EnergyAccount::default()
         }
+    }
+    fn validity_at(&self, hub: &HubState, x: &[f64]) -> Option<Validity> {
+        let c = self.conductor?;
+        let s = self.seen(hub);
+        let b_rate = self.b_rate(x[0], s.h, s.h_rate);
+        Some(Validity {
+            value: c.eddy_field(b_rate) / self.hysteresis.coercivity,
+            warn: EDDY_WARN,
+            limit: EDDY_LIMIT,
+        })
+    }
+    fn validity_report_at(&self, hub: &HubState, x: &[f64]) -> (String, String) {
+        let Some(c) = self.conductor else {
+            return Default::default();
+        };
+        let s = self.seen(hub);
+        let b_rate = self.b_rate(x[0], s.h, s.h_rate);
+        let field = c.eddy_field(b_rate);
+        (
+            format!(
+                "the rod's flux density changes at {b_rate:.4e} T/s (H along it at {:.4e} \
+                 A/m/s): its eddy currents (σ = {:.4e} S/m, r = {:e} m) set up σ r² |dB/dt|/4 = \
+                 {field:.4e} A/m on its axis, {:.3} of the coercivity {:.4e} A/m (warning at \
+                 {EDDY_WARN}, limit {EDDY_LIMIT}): the rate-independent loop of Flatley & \
+                 Henretty leaves that field out, and the rod's loop widens with it",
+                s.h_rate,
+                c.conductivity,
+                c.radius,
+                field / self.hysteresis.coercivity,
+                self.hysteresis.coercivity
+            ),
+            "a slower tumble, thinner rods, or a rate-dependent rod model (not in polhode)".into(),
+        )
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[

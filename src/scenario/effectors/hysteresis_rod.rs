@@ -13,6 +13,7 @@
 //!     saturation: 0.74         # T, apparent
 //!     # properties: material   # the three above are the material's instead; needs length
 //!                              # and diameter (the rod's demagnetising factor converts them)
+//!     # conductivity: 1.72e6   # S/m, for the eddy-current validity check (HyMu-80's)
 //!     # minor_loops: {q0: 0, p: 2}   # Flatley & Henretty's shape constants
 //! ```
 
@@ -20,7 +21,7 @@ use super::{Check, Context, ScenarioError, geomagnetic_field};
 use crate::effectors::HysteresisRod;
 use crate::effectors::eddy_currents::AmbientField;
 use crate::effectors::hysteresis_rod::{
-    DEFAULT_P, DEFAULT_Q0, HysteresisLoop, demagnetising_factor,
+    DEFAULT_P, DEFAULT_Q0, HYMU80_CONDUCTIVITY, HysteresisLoop, RodConductor, demagnetising_factor,
 };
 use serde::Deserialize;
 use serde_saphyr::Spanned;
@@ -54,6 +55,10 @@ pub struct HysteresisRodSpec {
     /// converted with the rod's demagnetising factor from `length` and `diameter`).
     #[serde(default)]
     pub properties: Option<Spanned<String>>,
+    /// Electrical conductivity (S/m) for the eddy-current validity check (default HyMu-80's,
+    /// 1.72e6 S/m); needs `diameter`.
+    #[serde(default)]
+    pub conductivity: Option<Spanned<f64>>,
     /// Flatley & Henretty's minor-loop constants (default q0 = 0, p = 2).
     #[serde(default)]
     pub minor_loops: Option<MinorLoopsSpec>,
@@ -99,12 +104,14 @@ pub(super) fn build(
         },
     };
     let mut aspect = None;
+    let mut radius = None;
     let volume = match (&spec.volume, &spec.length, &spec.diameter) {
         (Some(v), None, None) => ck.positive(v, "volume", "m^3")?,
         (None, Some(l), Some(d)) => {
             let l = ck.positive(l, "length", "m")?;
             let d = ck.positive(d, "diameter", "m")?;
             aspect = Some(l / d);
+            radius = Some(0.5 * d);
             0.25 * PI * d * d * l
         }
         _ => {
@@ -176,6 +183,14 @@ pub(super) fn build(
     if let Some(n) = demagnetising {
         hysteresis = hysteresis.apparent(n);
     }
+    let conductivity = match &spec.conductivity {
+        Some(c) => ck.positive(c, "conductivity", "S/m")?,
+        None => HYMU80_CONDUCTIVITY,
+    };
+    let conductor = radius.map(|radius| RodConductor {
+        radius,
+        conductivity,
+    });
     let field = geomagnetic_field(cx, item)?;
     Ok(HysteresisRod {
         name,
@@ -183,5 +198,6 @@ pub(super) fn build(
         axis,
         volume,
         hysteresis,
+        conductor,
     })
 }
