@@ -547,3 +547,34 @@ fn the_rods_eddy_currents_bound_the_model_during_the_run() {
     assert!(w > lo && w < hi, "{w} outside [{lo}, {hi}]");
     assert_eq!(out.warnings.len(), 1, "{:?}", out.warnings);
 }
+
+/// `field_angle_deg` (the settling measure of passive magnetic control) watches the
+/// `magnetic_dipole`'s angle to the field: refused, located, in a scene without one; with a
+/// magnet held along body z and the body at rest in inertial space, a condition on it fires.
+#[test]
+fn the_field_angle_condition_needs_a_magnet() {
+    let base = "name: x\nepoch: 2025-06-01T00:00:00Z\nbody: {principal: [1, 2, 3]}\n\
+                initial: {omega: [0, 0, 0]}\nduration: 10\norbit: {semi_major_axis_km: 7000}\n";
+    let got = refusal(&format!(
+        "{base}effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], volume: 1e-7, coercivity: \
+         12, remanence: 0.3, saturation: 0.74}}\nevents:\n  - {{field_angle_deg: {{below: \
+         10}}}}\n"
+    ));
+    let expected = "rod.yaml:10:5: field `events[0].field_angle_deg`: expected a \
+                    `magnetic_dipole` among the effectors";
+    assert!(got.contains(expected), "got: {got}\nexpected: {expected}");
+    let s = common::scenario(&format!(
+        "{base}effectors:\n  - magnetic_dipole: {{moment: [0, 0, 0.1]}}\nevents:\n  - \
+         {{field_angle_deg: {{below: 180}}}}\n"
+    ));
+    let mut rec = Memory::with_states();
+    let stop = AtomicBool::new(false);
+    let control = Control {
+        interrupt: &stop,
+        progress: None,
+    };
+    let out = sim::run(&s, &mut rec, control).unwrap();
+    assert_eq!(out.events.len(), 1, "{:?}", out.events);
+    let a = rec.samples[0].field_angle;
+    assert!(a > 0.0 && a < PI, "{a}");
+}
