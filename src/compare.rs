@@ -121,6 +121,7 @@ pub fn short_title(c: &Condition, with_once: bool) -> String {
         Quantity::Omega(i) => (format!("ω_{}", ["x", "y", "z"][i.min(2)]), ""),
         Quantity::KineticEnergy => ("T".to_string(), " J"),
         Quantity::RateDegS => ("|ω|".to_string(), "°/s"),
+        Quantity::FieldAngleDeg => ("∠m,B".to_string(), "°"),
     };
     let op = if c.above { ">" } else { "<" };
     let mut text = format!("{symbol} {op} {}{unit}", c.threshold);

@@ -150,6 +150,7 @@ impl Obs {
             external_work: self.external_work,
             nutation_angle: self.nutation_angle,
             angles_to_principal: self.angles_to_principal,
+            field_angle: f64::NAN,
         }
     }
 }

@@ -41,6 +41,10 @@ pub trait EnvironmentTorque: Debug + Send + Sync {
     fn validity_report(&self, _hub: &HubState) -> (String, String) {
         (String::new(), String::new())
     }
+    /// [`Effector::field_angle`] (rad); `None` by default.
+    fn field_angle(&self, _hub: &HubState) -> Option<f64> {
+        None
+    }
     /// Whether [`EnvironmentTorque::tidal_gradient`] gives a field.
     fn acts_on_moving_masses(&self) -> bool {
         false
@@ -125,6 +129,9 @@ impl<T: EnvironmentTorque + 'static> Effector for T {
     }
     fn telemetry(&self, hub: &HubState, x: &[f64]) -> Vec<f64> {
         EnvironmentTorque::telemetry(self, hub, x[0])
+    }
+    fn field_angle(&self, hub: &HubState) -> Option<f64> {
+        EnvironmentTorque::field_angle(self, hub)
     }
     fn validity_at(&self, hub: &HubState, _x: &[f64]) -> Option<Validity> {
         EnvironmentTorque::validity(self, hub)

@@ -42,7 +42,7 @@
 
 use super::eddy_currents::{AmbientField, MU_0};
 use super::environment::{names, to_body};
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState};
+use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Validity};
 use nalgebra::Vector3;
 use std::f64::consts::PI;
 
@@ -121,6 +121,111 @@ impl HysteresisLoop {
     }
 }
 
+/// The demagnetising factor N (1) along the symmetry axis of a uniformly magnetised spheroid of
+/// length-to-diameter ratio `m` (> 0): Osborn, "Demagnetizing factors of the general
+/// ellipsoid", Phys. Rev. 67, 351 (1945). For a prolate spheroid (m > 1)
+///
+/// ```text
+/// N = (m/√(m²−1) · ln(m + √(m²−1)) − 1) / (m² − 1)
+/// ```
+///
+/// 1/3 for a sphere, and for an oblate one (m < 1) N = (1 − m/√(1−m²) · acos m)/(1 − m²).
+/// A long rod of the same length and diameter is taken as this spheroid
+/// (docs/effectors.md says what that leaves out).
+pub fn demagnetising_factor(m: f64) -> f64 {
+    let d = m * m - 1.0;
+    if d.abs() < 1e-6 {
+        // The series about the sphere: N = 1/3 − (4/15)(m − 1) + O((m − 1)²).
+        return 1.0 / 3.0 - 4.0 / 15.0 * (m - 1.0);
+    }
+    if d > 0.0 {
+        let r = d.sqrt();
+        (m / r * (m + r).ln() - 1.0) / d
+    } else {
+        let r = (-d).sqrt();
+        (1.0 - m / r * m.acos()) / -d
+    }
+}
+
+/// Root of the increasing function `f` in [`lo`, `hi`] (f(lo) ≤ 0 ≤ f(hi)) by bisection, to
+/// the resolution of doubles.
+fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if f(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+impl HysteresisLoop {
+    /// The apparent loop of a rod whose material has this loop (B against the field H_in inside
+    /// the material) and whose demagnetising factor is `n` (0 < n < 1): the loop sheared by
+    /// H = H_in + N M, M = B/μ₀ − H_in, seen as the rod's B_app = μ₀(H + M) against the
+    /// applied H (so that its moment (B_app/μ₀ − H) V is M V). Its coercivity is the applied
+    /// H where B_app = 0 on the ascending branch, its remanence B_app at H = 0 on the
+    /// descending one (both solved on the material's branches), and its saturation the
+    /// material's (the magnetisation saturates at the same M_s); the minor-loop constants
+    /// are kept. For a long high-permeability rod the remanence is close to μ₀ H_c/N.
+    pub fn apparent(&self, n: f64) -> HysteresisLoop {
+        let m = |b: f64, h_in: f64| b / MU_0 - h_in;
+        // Ascending branch: B_app = (1 + N) B − N μ₀ H_in, increasing in H_in; zero near H_c.
+        let b_app = |h_in: f64| {
+            let b = self.limiting(h_in, true);
+            (1.0 + n) * b - n * MU_0 * h_in
+        };
+        let span = 4.0 * self.coercivity;
+        let h_in = bisect(b_app, self.coercivity - span, self.coercivity + span);
+        let coercivity = h_in + n * m(self.limiting(h_in, true), h_in);
+        // Descending branch at H = 0: H_in + N M = 0, increasing in H_in, in [−H_c, 0].
+        let applied = |h_in: f64| h_in + n * m(self.limiting(h_in, false), h_in);
+        let h_in = bisect(applied, -self.coercivity, 0.0);
+        let remanence = MU_0 * m(self.limiting(h_in, false), h_in);
+        HysteresisLoop {
+            coercivity,
+            remanence,
+            ..*self
+        }
+    }
+}
+
+/// The electrical conductivity of HyMu-80 (S/m): the reciprocal of its resistivity, 0.58 µΩ m
+/// (Carpenter Technology's datasheet of the alloy), the default for the rod's eddy currents.
+pub const HYMU80_CONDUCTIVITY: f64 = 1.0 / 0.58e-6;
+
+/// The eddy-current field over the coercivity past which a run is warned (the measure of the
+/// rod's validity).
+pub const EDDY_WARN: f64 = 0.1;
+
+/// The eddy-current field over the coercivity past which the rate-independent loop does not
+/// hold: a run stops (`checks.on_validity`).
+pub const EDDY_LIMIT: f64 = 1.0;
+
+/// The conductor behind a rod's eddy currents, for its validity range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RodConductor {
+    /// Radius r (m).
+    pub radius: f64,
+    /// Electrical conductivity σ (S/m).
+    pub conductivity: f64,
+}
+
+impl RodConductor {
+    /// The field (A/m) the eddy currents of a flux density changing at `b_rate` (T/s) set up
+    /// on the rod's axis, against the change: in a long cylinder with a uniform dB/dt along
+    /// it the current density is J(ρ) = σ ρ Ḃ/2 around the axis, and the field at the axis
+    /// ∫₀^r J dρ = σ r² Ḃ/4.
+    pub fn eddy_field(&self, b_rate: f64) -> f64 {
+        0.25 * self.conductivity * self.radius * self.radius * b_rate.abs()
+    }
+}
+
 /// A hysteresis rod on the hub.
 #[derive(Debug, Clone)]
 pub struct HysteresisRod {
@@ -134,6 +239,9 @@ pub struct HysteresisRod {
     pub volume: f64,
     /// Its loop.
     pub hysteresis: HysteresisLoop,
+    /// Its radius and conductivity, for the validity check (`None`: a rod given by its
+    /// volume, unchecked).
+    pub conductor: Option<RodConductor>,
 }
 
 /// What the rod sees at a hub state: the field (T, body axes), H along the rod (A/m) and its
@@ -251,6 +359,39 @@ impl Effector for HysteresisRod {
             work: x[WORK],
             ..EnergyAccount::default()
         }
+    }
+    fn validity_at(&self, hub: &HubState, x: &[f64]) -> Option<Validity> {
+        let c = self.conductor?;
+        let s = self.seen(hub);
+        let b_rate = self.b_rate(x[0], s.h, s.h_rate);
+        Some(Validity {
+            value: c.eddy_field(b_rate) / self.hysteresis.coercivity,
+            warn: EDDY_WARN,
+            limit: EDDY_LIMIT,
+        })
+    }
+    fn validity_report_at(&self, hub: &HubState, x: &[f64]) -> (String, String) {
+        let Some(c) = self.conductor else {
+            return Default::default();
+        };
+        let s = self.seen(hub);
+        let b_rate = self.b_rate(x[0], s.h, s.h_rate);
+        let field = c.eddy_field(b_rate);
+        (
+            format!(
+                "the rod's flux density changes at {b_rate:.4e} T/s (H along it at {:.4e} \
+                 A/m/s): its eddy currents (σ = {:.4e} S/m, r = {:e} m) set up σ r² |dB/dt|/4 = \
+                 {field:.4e} A/m on its axis, {:.3} of the coercivity {:.4e} A/m (warning at \
+                 {EDDY_WARN}, limit {EDDY_LIMIT}): the rate-independent loop of Flatley & \
+                 Henretty leaves that field out, and the rod's loop widens with it",
+                s.h_rate,
+                c.conductivity,
+                c.radius,
+                field / self.hysteresis.coercivity,
+                self.hysteresis.coercivity
+            ),
+            "a slower tumble, thinner rods, or a rate-dependent rod model (not in polhode)".into(),
+        )
     }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[

@@ -66,6 +66,11 @@ impl EnvironmentTorque for MagneticDipole {
     fn environment_torque(&self, hub: &HubState) -> Vector3<f64> {
         self.torque_at(hub.t, hub.attitude)
     }
+    fn field_angle(&self, hub: &HubState) -> Option<f64> {
+        let b = self.field_body(hub.t, hub.attitude);
+        // atan2(|m × b|, m·b) keeps its digits near 0 and π.
+        Some(self.moment.cross(&b).norm().atan2(self.moment.dot(&b)))
+    }
     fn telemetry_names(&self) -> Vec<String> {
         names(&[
             "torque_x", "torque_y", "torque_z", "b_x", "b_y", "b_z", "work",
@@ -109,6 +114,41 @@ mod tests {
             assert!(
                 (got - expected).norm() <= 1e-14 * expected.norm(),
                 "t = {t}: {got:?} vs {expected:?}"
+            );
+        }
+    }
+
+    /// The angle to the field against acos of the normalised dot product of the moment and
+    /// the field rotated by nalgebra, away from 0 and π where acos loses digits.
+    #[test]
+    fn the_field_angle_is_the_angle_between_moment_and_field() {
+        let orbit = Orbit::new(
+            CentralBody::EARTH,
+            Elements::new(6.9e6, 0.01, 0.9, 0.4, 1.1, 0.2),
+            false,
+        )
+        .unwrap();
+        let md = MagneticDipole {
+            name: "m".into(),
+            orbit: Arc::new(orbit),
+            field: GeomagneticField::new(1_700_000_000_000_000_000),
+            moment: Vector3::new(0.1, -0.2, 0.3),
+        };
+        let q = UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
+        let raw = [q.w, q.i, q.j, q.k];
+        for t in [0.0, 1234.5, 9876.0] {
+            let (r_hat, radius) = md.orbit.direction(t);
+            let b = q.inverse_transform_vector(&md.field.field_eci(t, &r_hat, radius));
+            let expected = (md.moment.dot(&b) / (md.moment.norm() * b.norm())).acos();
+            let hub = HubState {
+                t,
+                attitude: &raw,
+                omega: Vector3::zeros(),
+            };
+            let got = EnvironmentTorque::field_angle(&md, &hub).unwrap();
+            assert!(
+                (got - expected).abs() < 1e-12,
+                "t = {t}: {got} vs {expected}"
             );
         }
     }

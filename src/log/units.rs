@@ -381,7 +381,7 @@ pub fn field_unit(kind: &str, field: &str) -> Option<(Cow<'static, str>, &'stati
             return fixed("Applied field along the rod, H = ê·B/μ0", "A/m");
         }
         ("hysteresis_rod", "h_rate") => {
-            return fixed("Rate of the applied field along the rod, dH/dt", "A/(m s)");
+            return fixed("Rate of the applied field along the rod, dH/dt", "A/m/s");
         }
         ("hysteresis_rod", "moment") => {
             return fixed(

@@ -466,6 +466,11 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn validity_report(&self, _x: &[f64]) -> (String, String) {
         (String::new(), String::new())
     }
+    /// The angle (rad, [0, π]) between its magnetic moment and the local field at `hub`, for a
+    /// permanent magnet (`magnetic_dipole`): what `field_angle_deg` watches. `None` by default.
+    fn field_angle(&self, _hub: &HubState) -> Option<f64> {
+        None
+    }
     /// Where it stands against the range its model holds in at the hub state `hub` and its
     /// states `x`: what the run checks. The default is [`Effector::validity`], which sees its
     /// states only; a model whose range depends on the hub's motion (eddy currents: the skin
@@ -552,6 +557,9 @@ pub struct Spacecraft {
     translation: bool,
     /// Every effector is [`Effector::torque_only`] (and there is at least one).
     torque_only: bool,
+    /// Some effector has a [`Effector::field_angle`] (a permanent magnet): observations then
+    /// evaluate it.
+    pub(crate) has_magnet: bool,
     /// Effectors coupled together ([`EffectorGroup`]), rebuilt as effectors are added.
     groups: Vec<Box<dyn EffectorGroup>>,
     /// Whether each effector belongs to one of `groups`.
@@ -597,6 +605,7 @@ impl Spacecraft {
             scratch_len: 0,
             translation: false,
             torque_only: false,
+            has_magnet: false,
             groups: Vec::new(),
             grouped: Vec::new(),
             group_scratch: Vec::new(),
@@ -662,6 +671,7 @@ impl Spacecraft {
             }
             self.tidal_source = Some(self.effectors.len());
         }
+        self.has_magnet |= effector.kind() == "magnetic_dipole";
         self.torque_only =
             effector.torque_only() && (self.effectors.is_empty() || self.torque_only);
         self.offsets.push(self.dim);

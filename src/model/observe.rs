@@ -38,6 +38,9 @@ pub struct Observation {
     pub nutation_angle: f64,
     /// Angle between ω and each principal axis of the hub, in principal order (rad, [0, π]).
     pub angles_to_principal: [f64; 3],
+    /// Angle (rad) between the first permanent magnet's (`magnetic_dipole`) moment and the
+    /// local field; NaN without one.
+    pub field_angle: f64,
 }
 
 impl Observation {
@@ -192,7 +195,21 @@ pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64], angles: bool) -> Obser
         external_work: inv.external_work,
         nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
         angles_to_principal,
+        field_angle: field_angle(sc, t, y),
     }
+}
+
+/// The first effector's [`crate::model::Effector::field_angle`] at state `y` (rad), NaN if none
+/// has one.
+fn field_angle(sc: &Spacecraft, t: f64, y: &[f64]) -> f64 {
+    if !sc.has_magnet {
+        return f64::NAN;
+    }
+    let hub = sc.hub_state(t, y);
+    sc.effectors()
+        .iter()
+        .find_map(|e| e.field_angle(&hub))
+        .unwrap_or(f64::NAN)
 }
 
 #[cfg(test)]

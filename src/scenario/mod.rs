@@ -191,6 +191,8 @@ pub enum ConditionSpec {
     KineticEnergy(ThresholdSpec),
     /// The body's rate |ω| (deg/s): a detumbling's progress.
     RateDegS(ThresholdSpec),
+    /// Angle between the `magnetic_dipole`'s moment and the local field (degrees).
+    FieldAngleDeg(ThresholdSpec),
 }
 
 /// `{above: X}` or `{below: X}`: the condition holds while the quantity is above (below) X;
@@ -1278,6 +1280,22 @@ impl ScenarioFile {
 
         let drift_limits = drift_limits(path, self.checks, &spacecraft)?;
         warnings.splice(0..0, attitude_note);
+        // `field_angle_deg` watches a permanent magnet's angle to the field.
+        if !spacecraft.has_magnet {
+            for (list, specs) in [("stop", &self.stop), ("events", &self.events)] {
+                for (i, s) in specs.iter().enumerate() {
+                    if matches!(s.value, ConditionSpec::FieldAngleDeg(_)) {
+                        return Err(err(
+                            loc(s),
+                            &format!("{list}[{i}].field_angle_deg"),
+                            "expected a `magnetic_dipole` among the effectors: the angle is \
+                             between its moment and the local field"
+                                .to_string(),
+                        ));
+                    }
+                }
+            }
+        }
 
         Ok(Scenario {
             path: path.to_path_buf(),
@@ -1563,6 +1581,7 @@ fn conditions(
                 ConditionSpec::OmegaZ(t) => (Quantity::Omega(2), t),
                 ConditionSpec::KineticEnergy(t) => (Quantity::KineticEnergy, t),
                 ConditionSpec::RateDegS(t) => (Quantity::RateDegS, t),
+                ConditionSpec::FieldAngleDeg(t) => (Quantity::FieldAngleDeg, t),
             };
             let field = format!("{field}[{i}].{}", quantity.key());
             let (threshold, above) = match (th.above, th.below) {

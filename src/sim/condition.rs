@@ -15,6 +15,8 @@ pub enum Quantity {
     KineticEnergy,
     /// The body's rate |ω| (deg/s).
     RateDegS,
+    /// Angle between the permanent magnet's moment and the local field (degrees).
+    FieldAngleDeg,
 }
 
 impl Quantity {
@@ -30,6 +32,7 @@ impl Quantity {
             Quantity::Omega(_) => "omega_z",
             Quantity::KineticEnergy => "kinetic_energy",
             Quantity::RateDegS => "rate_deg_s",
+            Quantity::FieldAngleDeg => "field_angle_deg",
         }
     }
 
@@ -41,6 +44,7 @@ impl Quantity {
             Quantity::Omega(i) => o.omega[i],
             Quantity::KineticEnergy => o.kinetic_energy,
             Quantity::RateDegS => o.omega.norm().to_degrees(),
+            Quantity::FieldAngleDeg => o.field_angle.to_degrees(),
         }
     }
 }

@@ -11,13 +11,18 @@
 //!     coercivity: 12           # A/m, apparent (the rod's, shape demagnetisation included)
 //!     remanence: 0.35          # T, apparent
 //!     saturation: 0.74         # T, apparent
+//!     # properties: material   # the three above are the material's instead; needs length
+//!                              # and diameter (the rod's demagnetising factor converts them)
+//!     # conductivity: 1.72e6   # S/m, for the eddy-current validity check (HyMu-80's)
 //!     # minor_loops: {q0: 0, p: 2}   # Flatley & Henretty's shape constants
 //! ```
 
 use super::{Check, Context, ScenarioError, geomagnetic_field};
 use crate::effectors::HysteresisRod;
 use crate::effectors::eddy_currents::AmbientField;
-use crate::effectors::hysteresis_rod::{DEFAULT_P, DEFAULT_Q0, HysteresisLoop};
+use crate::effectors::hysteresis_rod::{
+    DEFAULT_P, DEFAULT_Q0, HYMU80_CONDUCTIVITY, HysteresisLoop, RodConductor, demagnetising_factor,
+};
 use serde::Deserialize;
 use serde_saphyr::Spanned;
 use std::f64::consts::PI;
@@ -40,12 +45,20 @@ pub struct HysteresisRodSpec {
     /// Diameter (m), with `length`.
     #[serde(default)]
     pub diameter: Option<Spanned<f64>>,
-    /// Apparent coercivity H_c (A/m).
+    /// Coercivity H_c (A/m), apparent unless `properties: material`.
     pub coercivity: Spanned<f64>,
-    /// Apparent remanence B_r (T), below `saturation`.
+    /// Remanence B_r (T), below `saturation`; apparent unless `properties: material`.
     pub remanence: Spanned<f64>,
-    /// Apparent saturation flux density B_s (T).
+    /// Saturation flux density B_s (T); apparent unless `properties: material`.
     pub saturation: Spanned<f64>,
+    /// Whether the loop is the rod's (`apparent`, the default) or its material's (`material`,
+    /// converted with the rod's demagnetising factor from `length` and `diameter`).
+    #[serde(default)]
+    pub properties: Option<Spanned<String>>,
+    /// Electrical conductivity (S/m) for the eddy-current validity check (default HyMu-80's,
+    /// 1.72e6 S/m); needs `diameter`.
+    #[serde(default)]
+    pub conductivity: Option<Spanned<f64>>,
     /// Flatley & Henretty's minor-loop constants (default q0 = 0, p = 2).
     #[serde(default)]
     pub minor_loops: Option<MinorLoopsSpec>,
@@ -76,11 +89,29 @@ pub(super) fn build(
     item: Option<(u32, u32)>,
 ) -> Result<HysteresisRod, ScenarioError> {
     let axis = ck.unit(&spec.axis, "axis")?;
+    let material = match &spec.properties {
+        None => false,
+        Some(p) => match p.value.as_str() {
+            "apparent" => false,
+            "material" => true,
+            other => {
+                return Err(ck.err(
+                    p,
+                    "properties",
+                    format!("expected `apparent` or `material`, got `{other}`"),
+                ));
+            }
+        },
+    };
+    let mut aspect = None;
+    let mut radius = None;
     let volume = match (&spec.volume, &spec.length, &spec.diameter) {
         (Some(v), None, None) => ck.positive(v, "volume", "m^3")?,
         (None, Some(l), Some(d)) => {
             let l = ck.positive(l, "length", "m")?;
             let d = ck.positive(d, "diameter", "m")?;
+            aspect = Some(l / d);
+            radius = Some(0.5 * d);
             0.25 * PI * d * d * l
         }
         _ => {
@@ -116,6 +147,21 @@ pub(super) fn build(
         ));
     }
     let mut hysteresis = HysteresisLoop::new(coercivity, remanence, saturation);
+    // The material loop becomes the rod's through its demagnetising factor.
+    let demagnetising = match (material, aspect) {
+        (false, _) => None,
+        (true, Some(m)) => Some(demagnetising_factor(m)),
+        (true, None) => {
+            return Err(ck.err(
+                spec.properties
+                    .as_ref()
+                    .expect("material is set by `properties`"),
+                "properties",
+                "expected `length` and `diameter` with `properties: material` (the \
+                 demagnetising factor needs the rod's length-to-diameter ratio), got `volume`",
+            ));
+        }
+    };
     if let Some(m) = &spec.minor_loops {
         let q0 = m.q0.value;
         if !(0.0..=1.0).contains(&q0) {
@@ -134,6 +180,17 @@ pub(super) fn build(
         hysteresis.q0 = DEFAULT_Q0;
         hysteresis.p = DEFAULT_P;
     }
+    if let Some(n) = demagnetising {
+        hysteresis = hysteresis.apparent(n);
+    }
+    let conductivity = match &spec.conductivity {
+        Some(c) => ck.positive(c, "conductivity", "S/m")?,
+        None => HYMU80_CONDUCTIVITY,
+    };
+    let conductor = radius.map(|radius| RodConductor {
+        radius,
+        conductivity,
+    });
     let field = geomagnetic_field(cx, item)?;
     Ok(HysteresisRod {
         name,
@@ -141,5 +198,6 @@ pub(super) fn build(
         axis,
         volume,
         hysteresis,
+        conductor,
     })
 }
