@@ -583,6 +583,7 @@ impl Secular for Tabulated {
             energy_rate: -p,
             h_rate: 0.0,
             dissipation_rate: p,
+            ..SecularRates::default()
         }
     }
 }

@@ -9,6 +9,7 @@
 //! - [`stepper`]: the slow system stepped by DOP853, and the full state rebuilt from the exact
 //!   solution for sampling, events and logs.
 
+pub mod eddy;
 pub mod forced;
 pub mod motion;
 pub mod stepper;
@@ -18,6 +19,11 @@ pub use stepper::{AveragedStepper, refusal};
 /// Largest ratio ε of the fast period to the dissipation time at which the averaged method
 /// runs (dimensionless): its error in the slow variables is O(ε).
 pub const MAX_EPSILON: f64 = 1e-2;
+
+/// Largest ratio of the fast period to the period of an orbit-driven forcing (the orbit
+/// period, for eddy currents in the geomagnetic field) at which the averaged method averages
+/// the two independently (dimensionless).
+pub const MAX_FAST_TO_FORCING: f64 = 1e-2;
 
 /// Within 1 − m < this of the separatrix the polhode period (which diverges there) is left out
 /// of ε (dimensionless).

@@ -3,10 +3,10 @@
 //! solution at the slow state, so that sampling, events and logs work as for other methods.
 
 use super::motion::{Moments, PeriodAverages};
-use super::{MAX_EPSILON, SEPARATRIX_LAYER};
+use super::{MAX_EPSILON, MAX_FAST_TO_FORCING, SEPARATRIX_LAYER};
 use crate::exact::TorqueFreeSolution;
 use crate::integrate::{Dop853, OdeSystem, Stats, StepError, Stepper, Tolerances};
-use crate::model::{Secular, SecularMotion, Spacecraft};
+use crate::model::{Forcing, Secular, SecularMotion, Spacecraft};
 use crate::sim::Adaptive;
 use nalgebra::{Matrix3, Quaternion, Rotation3, Unit, UnitQuaternion, Vector3};
 use std::f64::consts::TAU;
@@ -16,12 +16,13 @@ use std::f64::consts::TAU;
 const SEPARATRIX_ROUNDING: f64 = 64.0 * f64::EPSILON;
 
 /// Slow state layout: z = [|H|/H₀, T/T₀, polhode phase (periods), precession angle (rad),
-/// W₁/T₀, …].
+/// W₁/T₀, …], with the unit vector Ĥ (inertial axes) after the precession angle when an
+/// effector's forcing depends on the orbit (z = [.., Ĥx, Ĥy, Ĥz, W₁/T₀, …]).
 const H: usize = 0;
 const T: usize = 1;
 const PHASE: usize = 2;
 const PRECESSION: usize = 3;
-const EFFECTORS: usize = 4;
+const DIRECTION: usize = 4;
 
 /// The slow system: the period-averaged rates of |H|, T, the fast phases and each effector's
 /// dissipated energy, functions of (|H|, T) only.
@@ -32,6 +33,17 @@ struct SlowSystem {
     effects: Vec<Box<dyn Secular>>,
     h0: f64,
     t0: f64,
+    /// Ĥ at t = 0 (inertial axes): constant unless the direction is carried.
+    h_hat0: Vector3<f64>,
+    /// Whether z carries Ĥ: some effector's forcing depends on the orbit.
+    direction: bool,
+    /// The tightest forcing: the shortest orbit period and the longest window (s).
+    forcing: Option<Forcing>,
+    /// Index in z of the first effector's energy.
+    effectors_at: usize,
+    /// An axisymmetric body whose effectors see the precession alone
+    /// ([`Secular::phase_free`]): the fast period is the precession's, not the polhode's.
+    precession_only: bool,
 }
 
 /// Everything the slow rates give at one slow state.
@@ -39,10 +51,21 @@ struct SlowRates {
     averages: PeriodAverages,
     h_rate: f64,
     energy_rate: f64,
+    /// dĤ/dt (1/s, inertial axes).
+    turn: Vector3<f64>,
 }
 
 impl SlowSystem {
-    fn rates(&self, z: &[f64], dissipation: Option<&mut [f64]>) -> SlowRates {
+    /// Ĥ (inertial axes) at slow state `z`.
+    fn h_hat(&self, z: &[f64]) -> Vector3<f64> {
+        if self.direction {
+            Vector3::new(z[DIRECTION], z[DIRECTION + 1], z[DIRECTION + 2]).normalize()
+        } else {
+            self.h_hat0
+        }
+    }
+
+    fn rates(&self, t: f64, z: &[f64], dissipation: Option<&mut [f64]>) -> SlowRates {
         let h = z[H] * self.h0;
         // Past a pure spin the rates are the pure spin's (zero for a passive scene), so an
         // overshoot of the slow stepper neither pumps nor drains what cannot be there.
@@ -53,13 +76,17 @@ impl SlowSystem {
             h,
             energy,
             inertia: &self.inertia,
+            t,
+            h_hat: self.h_hat(z),
         };
         let (mut h_rate, mut energy_rate) = (0.0, 0.0);
+        let mut across = Vector3::zeros();
         let mut dissipation = dissipation;
         for (k, e) in self.effects.iter().enumerate() {
             let r = e.rates(&motion);
             h_rate += r.h_rate;
             energy_rate += r.energy_rate;
+            across += r.torque_across;
             if let Some(d) = dissipation.as_deref_mut() {
                 d[k] = r.dissipation_rate / self.t0;
             }
@@ -68,36 +95,86 @@ impl SlowSystem {
             averages,
             h_rate,
             energy_rate,
+            turn: across / h,
         }
     }
 
-    /// ε: the fast period over the dissipation time, and the fast period (s). The fast period
+    /// ε: the fast period over the dissipation time, and the period compared (s). The fast period
     /// is the longer of the spin period about H, 2π|H|/(2T), and the polhode period (left out
     /// within the separatrix layer, where it diverges); the dissipation time is the shorter of
-    /// (T_max − T_min)/|dT/dt| and |H|/|d|H|/dt|.
-    fn epsilon(&self, z: &[f64]) -> (f64, f64) {
-        let r = self.rates(z, None);
+    /// (T_max − T_min)/|dT/dt|, |H|/|d|H|/dt| and 1/|dĤ/dt|. With an orbit-driven forcing the
+    /// period compared is at least its averaging window, and T's rate is taken at fixed
+    /// 2T/|H|², the shape of the polhode: |H| and T then fall together, and the polhode's
+    /// shape changes only through the difference, (dT/dt − (2T/|H|) d|H|/dt).
+    fn epsilon(&self, t: f64, z: &[f64]) -> (f64, f64) {
+        let r = self.rates(t, z, None);
         let h = z[H] * self.h0;
         let energy = z[T] * self.t0;
         let [i1, _, i3] = self.moments.i;
-        let mut fast = TAU * h / (2.0 * energy).max(f64::MIN_POSITIVE);
-        if r.averages.m < 1.0 - SEPARATRIX_LAYER && r.averages.period.is_finite() {
-            fast = fast.max(r.averages.period);
-        }
+        let fast = self.fast_period(&r.averages, h, energy);
         let band = h * h * (1.0 / (2.0 * i1) - 1.0 / (2.0 * i3));
-        let tau_t = band / r.energy_rate.abs();
+        let (tau_t, slowest) = match self.forcing {
+            Some(f) => {
+                let shape_rate = r.energy_rate - 2.0 * energy / h * r.h_rate;
+                (band / shape_rate.abs(), fast.max(f.window))
+            }
+            None => (band / r.energy_rate.abs(), fast),
+        };
         let tau_h = h / r.h_rate.abs();
-        (fast / tau_t.min(tau_h), fast)
+        let tau_turn = 1.0 / r.turn.norm();
+        (slowest / tau_t.min(tau_h).min(tau_turn), slowest)
+    }
+
+    /// The fast period (s): the longer of the spin period about H and the polhode period (or,
+    /// with [`SlowSystem::precession_only`], the precession period).
+    fn fast_period(&self, averages: &PeriodAverages, h: f64, energy: f64) -> f64 {
+        let fast = TAU * h / (2.0 * energy).max(f64::MIN_POSITIVE);
+        if self.precession_only {
+            fast.max(TAU / averages.precession_rate)
+        } else if averages.m < 1.0 - SEPARATRIX_LAYER && averages.period.is_finite() {
+            fast.max(averages.period)
+        } else {
+            fast
+        }
+    }
+
+    /// What [`SlowSystem::epsilon`] compares with the dissipation time, in words.
+    fn period_name(&self) -> &'static str {
+        if self.forcing.is_some_and(|f| f.window > 0.0) {
+            "field's averaging window (one orbit and one sidereal day) or the fast period"
+        } else {
+            "fast period"
+        }
+    }
+
+    /// Where averaging over the orbit-driven forcing fails, in words: the fast motion (the
+    /// longer of the spin period about H and the polhode period) must be short against the
+    /// orbit period, so that the field is independent of the fast phases.
+    fn forcing_refusal(&self, z: &[f64]) -> Option<String> {
+        let f = self.forcing.filter(|f| f.period > 0.0)?;
+        let h = z[H] * self.h0;
+        let energy = self.moments.admissible_energy(h, z[T] * self.t0);
+        let averages = self.moments.period_averages(h, energy);
+        let fast = self.fast_period(&averages, h, energy);
+        let ratio = fast / f.period;
+        (ratio.is_nan() || ratio > MAX_FAST_TO_FORCING).then(|| {
+            format!(
+                "the fast period ({fast:.3e} s) is {ratio:.2e} of the orbit period ({:.3e} s), \
+                 and averaging the field over the orbit independently of the body's motion \
+                 needs it below {MAX_FAST_TO_FORCING:e}",
+                f.period
+            )
+        })
     }
 }
 
 impl OdeSystem for SlowSystem {
     fn dim(&self) -> usize {
-        EFFECTORS + self.effects.len()
+        self.effectors_at + self.effects.len()
     }
-    fn rhs(&self, _t: f64, z: &[f64], dz: &mut [f64]) {
-        let (head, tail) = dz.split_at_mut(EFFECTORS);
-        let r = self.rates(z, Some(tail));
+    fn rhs(&self, t: f64, z: &[f64], dz: &mut [f64]) {
+        let (head, tail) = dz.split_at_mut(self.effectors_at);
+        let r = self.rates(t, z, Some(tail));
         head[H] = r.h_rate / self.h0;
         head[T] = r.energy_rate / self.t0;
         head[PHASE] = if r.averages.period.is_finite() {
@@ -106,6 +183,9 @@ impl OdeSystem for SlowSystem {
             0.0
         };
         head[PRECESSION] = r.averages.precession_rate;
+        if self.direction {
+            head[DIRECTION..DIRECTION + 3].copy_from_slice(r.turn.as_slice());
+        }
     }
 }
 
@@ -140,7 +220,12 @@ pub fn refusal(sc: &Spacecraft) -> Option<String> {
     }
     let internal = sc.effectors().iter().any(|e| e.num_dynamic_states() > 0);
     for e in sc.effectors() {
-        if e.secular().is_some() && !internal {
+        if let Some(mut s) = e.secular()
+            && !internal
+        {
+            if let Err(why) = s.prepare(&sc.hub.inertia) {
+                return Some(refused(e.as_ref(), &why));
+            }
             continue;
         }
         if internal && is_internal(e.as_ref()) {
@@ -248,8 +333,27 @@ impl AveragedStepper {
                 })
                 .collect()
         } else {
-            sc.effectors().iter().filter_map(|e| e.secular()).collect()
+            let mut effects: Vec<Box<dyn Secular>> =
+                sc.effectors().iter().filter_map(|e| e.secular()).collect();
+            for (e, s) in sc.effectors().iter().zip(effects.iter_mut()) {
+                s.prepare(&inertia)
+                    .map_err(|why| refused(e.as_ref(), &why))?;
+            }
+            effects
         };
+        // The tightest forcing: the shortest orbit period, the longest window.
+        let forcings: Vec<Forcing> = effects.iter().filter_map(|e| e.forcing()).collect();
+        let direction = !forcings.is_empty();
+        let forcing = forcings.into_iter().reduce(|a, b| Forcing {
+            period: if a.period > 0.0 && b.period > 0.0 {
+                a.period.min(b.period)
+            } else {
+                a.period.max(b.period)
+            },
+            window: a.window.max(b.window),
+        });
+        let precession_only =
+            direction && (i1 == i2 || i2 == i3) && effects.iter().all(|e| e.phase_free());
         let system = SlowSystem {
             moments,
             axes,
@@ -257,14 +361,22 @@ impl AveragedStepper {
             effects,
             h0,
             t0,
+            h_hat0: h_hat_n,
+            direction,
+            forcing,
+            effectors_at: if direction { DIRECTION + 3 } else { DIRECTION },
+            precession_only,
         };
         let (phase, branch) = moments.phase_of(&w_p);
         let mut z0 = vec![0.0; system.dim()];
         z0[H] = 1.0;
         z0[T] = 1.0;
         z0[PHASE] = phase;
+        if direction {
+            z0[DIRECTION..DIRECTION + 3].copy_from_slice(h_hat_n.as_slice());
+        }
         for (k, &o) in offsets.iter().enumerate() {
-            z0[EFFECTORS + k] = y0[o] / t0;
+            z0[system.effectors_at + k] = y0[o] / t0;
         }
         // On the separatrix the averaged rates vanish (the period is infinite and ω sits on
         // the intermediate axis), so the slow system would stay there for ever while the full
@@ -280,12 +392,18 @@ impl AveragedStepper {
                 d2.abs() / (h0 * h0)
             ));
         }
-        let (epsilon, fast) = system.epsilon(&z0);
+        if let Some(why) = system.forcing_refusal(&z0) {
+            return Err(format!(
+                "method `averaged`: at the start, {why}; use dop853"
+            ));
+        }
+        let (epsilon, fast) = system.epsilon(0.0, &z0);
         if epsilon.is_nan() || epsilon > MAX_EPSILON {
             return Err(format!(
                 "method `averaged` needs dissipation slow next to the motion it averages over, \
-                 and here the fast period ({fast:.3e} s) is {epsilon:.2e} of the dissipation \
-                 time (the limit is {MAX_EPSILON:e}); use dop853"
+                 and here the {} ({fast:.3e} s) is {epsilon:.2e} of the dissipation \
+                 time (the limit is {MAX_EPSILON:e}); use dop853",
+                system.period_name()
             ));
         }
         let mut stepper = AveragedStepper {
@@ -335,10 +453,11 @@ impl AveragedStepper {
         let y_b = s.axes.column(1).into_owned();
         let x_b = y_b.cross(&z_b);
         let body = Matrix3::from_columns(&[x_b, y_b, z_b]);
+        let frame_n = self.frame_at(z);
         let q_ref = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-            self.frame_n * body.transpose(),
+            frame_n * body.transpose(),
         ));
-        let h_hat_n = Unit::new_unchecked(self.frame_n.column(2).into_owned());
+        let h_hat_n = Unit::new_unchecked(frame_n.column(2).into_owned());
         let solution = TorqueFreeSolution::new(&s.inertia, &omega_ref, &q_ref)
             .map_err(|e| format!("the torque-free solution at the slow state failed: {e}"))?;
         let period = solution.polhode_period();
@@ -366,9 +485,24 @@ impl AveragedStepper {
         out[5] = sign * q.j;
         out[6] = sign * q.k;
         for (k, &o) in self.offsets.iter().enumerate() {
-            out[o] = z[EFFECTORS + k] * s.t0;
+            out[o] = z[s.effectors_at + k] * s.t0;
         }
         Ok(())
+    }
+
+    /// The inertial frame (X, Y, Ĥ_N) at slow state `z`: the initial one, turned by the
+    /// smallest rotation from the initial Ĥ to the current one when the direction is carried.
+    fn frame_at(&self, z: &[f64]) -> Matrix3<f64> {
+        if !self.system.direction {
+            return self.frame_n;
+        }
+        // Rodrigues' form of the smallest rotation from a to b (unit vectors, not opposite):
+        // 1 + [v]× + [v]×² / (1 + a·b) with v = a × b, without cancellation as b → a.
+        let (a, b) = (self.system.h_hat0, self.system.h_hat(z));
+        let v = a.cross(&b);
+        let k = v.cross_matrix();
+        let turn = Matrix3::identity() + k + k * k / (1.0 + a.dot(&b));
+        turn * self.frame_n
     }
 
     /// Whether the polhode circulates about axis 3 at slow state `z`.
@@ -430,11 +564,25 @@ fn slow_stepper(z0: &[f64], a: &Adaptive) -> Dop853 {
 
 /// A right-handed frame whose third column is `z` (unit).
 fn inertial_frame(z: &Vector3<f64>) -> Matrix3<f64> {
+    let x = perpendicular(z);
+    Matrix3::from_columns(&[x, z.cross(&x), *z])
+}
+
+/// A unit vector perpendicular to the unit vector `z`.
+pub(crate) fn perpendicular(z: &Vector3<f64>) -> Vector3<f64> {
     let least = z.iamin();
     let mut e = Vector3::zeros();
     e[least] = 1.0;
-    let x = (e - z * z.dot(&e)).normalize();
-    Matrix3::from_columns(&[x, z.cross(&x), *z])
+    (e - z * z.dot(&e)).normalize()
+}
+
+/// The refusal of effector `e`, which cannot be averaged on this hub because `why`.
+fn refused(e: &dyn crate::model::Effector, why: &str) -> String {
+    format!(
+        "method `averaged` cannot treat effector `{}` ({}): {why}; use dop853",
+        e.name(),
+        e.kind()
+    )
 }
 
 impl Stepper for AveragedStepper {
@@ -459,12 +607,18 @@ impl Stepper for AveragedStepper {
             self.cross_separatrix(t0).map_err(sub)?;
         }
         let z = self.slow.y().to_vec();
-        let (epsilon, fast) = self.system.epsilon(&z);
+        if let Some(why) = self.system.forcing_refusal(&z) {
+            return Err(sub(format!(
+                "averaging no longer holds at t = {t1:.6e} s: {why}"
+            )));
+        }
+        let (epsilon, fast) = self.system.epsilon(t1, &z);
         if epsilon.is_nan() || epsilon > MAX_EPSILON {
             return Err(sub(format!(
-                "averaging no longer holds at t = {t1:.6e} s: the fast period ({fast:.3e} s) \
+                "averaging no longer holds at t = {t1:.6e} s: the {} ({fast:.3e} s) \
                  has grown to {epsilon:.2e} of the dissipation time (the limit is \
-                 {MAX_EPSILON:e})"
+                 {MAX_EPSILON:e})",
+                self.system.period_name()
             )));
         }
         let mut y = self.y.clone();

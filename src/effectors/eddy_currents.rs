@@ -34,7 +34,8 @@
 //! effector's validity measure.
 
 use super::environment::{EnvironmentTorque, names, to_body};
-use crate::model::{HubState, Validity};
+use crate::averaging::eddy::{AveragedEddy, FieldMoments};
+use crate::model::{HubState, Secular, Validity};
 use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::PI;
@@ -284,6 +285,15 @@ impl EnvironmentTorque for EddyCurrents {
         self.material
             .map(|m| m.report(hub.omega.norm()))
             .unwrap_or_default()
+    }
+    fn secular(&self) -> Option<Box<dyn Secular>> {
+        let field = match &self.field {
+            AmbientField::Geomagnetic { orbit, field } => {
+                FieldMoments::orbit(orbit.clone(), field.clone())
+            }
+            AmbientField::Uniform(b) => FieldMoments::Uniform(b * b.transpose()),
+        };
+        Some(Box::new(AveragedEddy::new(self.tensor, field)))
     }
 }
 

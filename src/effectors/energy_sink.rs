@@ -121,6 +121,7 @@ impl Secular for EnergySink {
             energy_rate: -power,
             h_rate: 0.0,
             dissipation_rate: power,
+            ..SecularRates::default()
         }
     }
 }

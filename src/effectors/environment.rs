@@ -8,7 +8,9 @@
 //! attitude and rates: most use the first two, eddy currents the rates too), and, when its
 //! model holds only in a range of that state, where it stands.
 
-use crate::model::{Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Validity};
+use crate::model::{
+    Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Secular, Validity,
+};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Debug;
 
@@ -48,6 +50,12 @@ pub trait EnvironmentTorque: Debug + Send + Sync {
     /// Whether [`EnvironmentTorque::tidal_gradient`] gives a field.
     fn acts_on_moving_masses(&self) -> bool {
         false
+    }
+    /// Its effect averaged over the torque-free motion and the orbit, for `method: averaged`
+    /// ([`Effector::secular`]); `None` (the default) when it cannot be averaged. Its one
+    /// state, the work, grows at the averaged power.
+    fn secular(&self) -> Option<Box<dyn Secular>> {
+        None
     }
 }
 
@@ -138,6 +146,9 @@ impl<T: EnvironmentTorque + 'static> Effector for T {
     }
     fn validity_report_at(&self, hub: &HubState, _x: &[f64]) -> (String, String) {
         EnvironmentTorque::validity_report(self, hub)
+    }
+    fn secular(&self) -> Option<Box<dyn Secular>> {
+        EnvironmentTorque::secular(self)
     }
 }
 

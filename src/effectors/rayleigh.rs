@@ -100,6 +100,7 @@ impl Secular for Rayleigh {
             energy_rate: -power,
             h_rate,
             dissipation_rate: power,
+            ..SecularRates::default()
         }
     }
 }

@@ -23,7 +23,7 @@ mod secular;
 
 pub use body::{InertiaError, RigidBody};
 pub use observe::{Invariants, Observation};
-pub use secular::{Secular, SecularMotion, SecularRates};
+pub use secular::{Forcing, Secular, SecularMotion, SecularRates};
 
 use crate::integrate::OdeSystem;
 use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector3, Vector6};

@@ -16,8 +16,8 @@ use crate::model::Spacecraft;
 /// A feature of a scene that a method may not support.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Feature {
-    /// Torques that depend on the rates alone and average over the torque-free motion
-    /// (`rayleigh`, `energy_sink`).
+    /// Torques that average over the torque-free motion (`rayleigh`, `energy_sink`, and
+    /// `eddy_currents` over the orbit as well).
     DissipationTorques,
     /// Other torque-only effectors: environmental torques (gravity gradient, aerodynamic,
     /// solar pressure, magnetic), magnetorquers.

@@ -1,0 +1,341 @@
+//! Eddy-current damping averaged over the torque-free motion and the orbit
+//! (docs/averaging.md, "Eddy currents").
+//!
+//! The torque τ = (M (ω × B)) × B = [B]× M [B]× ω is linear in ω and quadratic in B. When the
+//! body turns many times per orbit and the orbit-driven field is independent of the fast
+//! phases (no resonance), the mean over both is the mean over the body's motion of a torque
+//! in which B Bᵀ is replaced by its orbit average S = ⟨B Bᵀ⟩ (inertial axes):
+//!
+//! ```text
+//! ⟨[B]× M [B]×⟩ = G(S, M) = tr S · M + tr M · S − S M − M S − (tr S tr M − tr(S M)) 1
+//! ```
+//!
+//! for symmetric S and M. S is the field's second moment averaged over a window of one orbit
+//! convolved with one sidereal day ([`FieldMoments`]), sampled every two days and
+//! interpolated.
+
+use crate::model::{Forcing, Secular, SecularMotion, SecularRates};
+use crate::orbit::{GeomagneticField, Orbit};
+use nalgebra::{Matrix3, Vector3};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+/// The sidereal day (s): the period of the Earth's rotation against the stars.
+pub const SIDEREAL_DAY: f64 = 86_164.090_5;
+
+/// Spacing of the windows at which S is computed (s): two days.
+pub const WINDOW_SPACING: f64 = 2.0 * 86_400.0;
+
+/// Field samples per orbit in a window's quadrature.
+pub const SAMPLES_PER_ORBIT: usize = 16;
+
+/// Relative tolerance within which the body is taken as axisymmetric and M as axisymmetric
+/// about its symmetry axis, or isotropic.
+const SHAPE_TOLERANCE: f64 = 1e-9;
+
+/// Points over the precession angle in the cone average: the averaged quantities are
+/// trigonometric polynomials of degree at most 4 in it, which 8 equally spaced points
+/// integrate exactly.
+const CONE_POINTS: usize = 8;
+
+/// G(S, M) = ⟨[B]× M [B]×⟩ for ⟨B Bᵀ⟩ = S, both symmetric.
+pub fn field_tensor(s: &Matrix3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
+    let (ts, tm) = (s.trace(), m.trace());
+    let sm = s * m;
+    m * ts + s * tm - sm - sm.transpose() - Matrix3::identity() * (ts * tm - sm.trace())
+}
+
+/// The orbit-averaged second moment S(t) = ⟨B Bᵀ⟩ (T², inertial axes) of the field the body
+/// turns in.
+#[derive(Debug)]
+pub enum FieldMoments {
+    /// A field constant in inertial axes: S = B Bᵀ.
+    Uniform(Matrix3<f64>),
+    /// The geomagnetic field along an orbit, windowed and interpolated.
+    Orbit {
+        /// The orbit.
+        orbit: Arc<Orbit>,
+        /// The field model.
+        field: GeomagneticField,
+        /// Windows computed so far, by index (window k is centred at k·[`WINDOW_SPACING`]).
+        cache: Mutex<HashMap<i64, Matrix3<f64>>>,
+        /// The first and last window inside the field model's years: beyond them S is held
+        /// (a slow stepper's trial stage may look past the end of the run).
+        windows: (i64, i64),
+    },
+}
+
+impl FieldMoments {
+    /// The geomagnetic field along `orbit`.
+    pub fn orbit(orbit: Arc<Orbit>, field: GeomagneticField) -> FieldMoments {
+        let (first, last) = field.years();
+        let year = 365.25 * 86_400.0;
+        let half = 0.5 * (SIDEREAL_DAY + orbit.period()) + WINDOW_SPACING;
+        let lo = (first - field.year(0.0)) * year + half;
+        let hi = (last - field.year(0.0)) * year - half;
+        let windows = (
+            (lo / WINDOW_SPACING).ceil() as i64,
+            (hi / WINDOW_SPACING).floor() as i64,
+        );
+        FieldMoments::Orbit {
+            orbit,
+            field,
+            cache: Mutex::new(HashMap::new()),
+            windows,
+        }
+    }
+
+    /// The forcing periods, for a field that depends on the orbit.
+    pub fn forcing(&self) -> Option<Forcing> {
+        match self {
+            FieldMoments::Uniform(_) => None,
+            FieldMoments::Orbit { orbit, .. } => Some(Forcing {
+                period: orbit.period(),
+                window: SIDEREAL_DAY + orbit.period(),
+            }),
+        }
+    }
+
+    /// S at `t` (s): for the orbit, the cubic (Catmull–Rom) interpolant of the window means.
+    pub fn at(&self, t: f64) -> Matrix3<f64> {
+        match self {
+            FieldMoments::Uniform(s) => *s,
+            FieldMoments::Orbit {
+                orbit,
+                field,
+                cache,
+                windows,
+            } => {
+                let x = t / WINDOW_SPACING;
+                let k = x.floor();
+                let u = x - k;
+                let k = k as i64;
+                let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
+                let mut get = |j: i64| {
+                    let j = j.clamp(windows.0, windows.1.max(windows.0));
+                    *cache
+                        .entry(j)
+                        .or_insert_with(|| window_mean(orbit, field, j as f64 * WINDOW_SPACING))
+                };
+                let (p0, p1, p2, p3) = (get(k - 1), get(k), get(k + 1), get(k + 2));
+                let (u2, u3) = (u * u, u * u * u);
+                (p1 * 2.0
+                    + (p2 - p0) * u
+                    + (p0 * 2.0 - p1 * 5.0 + p2 * 4.0 - p3) * u2
+                    + (p1 * 3.0 - p0 - p2 * 3.0 + p3) * u3)
+                    * 0.5
+            }
+        }
+    }
+}
+
+/// The mean of B Bᵀ (T², inertial axes) about `centre` (s), weighted by a box of one orbit
+/// period P convolved with a box of one sidereal day D (a trapezoid of base P + D): it removes
+/// the harmonics of the orbit (to first order in the Earth's rotation over one orbit) and of
+/// the day. Both boxes are rounded to whole samples, P/[`SAMPLES_PER_ORBIT`] apart, so the
+/// weight's corners fall on samples and the composite trapezoid rule is exact for it.
+pub fn window_mean(orbit: &Orbit, field: &GeomagneticField, centre: f64) -> Matrix3<f64> {
+    let p = orbit.period();
+    let step = p / SAMPLES_PER_ORBIT as f64;
+    let np = SAMPLES_PER_ORBIT as i64;
+    let nd = (SIDEREAL_DAY / step).round() as i64;
+    let half = (np + nd) / 2;
+    let mut sum = Matrix3::zeros();
+    let mut weights = 0.0;
+    for i in -half..=half {
+        // The trapezoid: 1 on the plateau, falling linearly to 0 at ±(P + D)/2.
+        let w = ((half - i.abs()) as f64 / np as f64).clamp(0.0, 1.0);
+        if w == 0.0 {
+            continue;
+        }
+        let b = field.field_on_orbit(orbit, centre + i as f64 * step);
+        sum += b * b.transpose() * w;
+        weights += w;
+    }
+    sum / weights
+}
+
+/// How the torque is averaged over the body's motion.
+#[derive(Debug, Clone, Copy)]
+enum Shape {
+    /// Not prepared yet.
+    Unprepared,
+    /// M = μ 1 on any non-spherical body: closed form from ⟨ω ωᵀ⟩.
+    Isotropic(f64),
+    /// An axisymmetric body with M axisymmetric about the same axis (or isotropic): the
+    /// regular precession's cone, in closed form by quadrature over the precession angle.
+    Coaxial {
+        /// Moment about the symmetry axis and across it (kg m²).
+        i_s: f64,
+        i_t: f64,
+        /// M across the axis and its excess along it (S m⁴).
+        m_t: f64,
+        m_excess: f64,
+    },
+}
+
+/// Eddy currents as the averaged method sees them.
+#[derive(Debug)]
+pub struct AveragedEddy {
+    /// The magnetic tensor M (S m⁴, body axes).
+    pub tensor: Matrix3<f64>,
+    /// The field's orbit-averaged second moment.
+    pub field: FieldMoments,
+    shape: Shape,
+}
+
+impl AveragedEddy {
+    /// Eddy currents of tensor `tensor` in the field `field`.
+    pub fn new(tensor: Matrix3<f64>, field: FieldMoments) -> AveragedEddy {
+        AveragedEddy {
+            tensor,
+            field,
+            shape: Shape::Unprepared,
+        }
+    }
+}
+
+impl Secular for AveragedEddy {
+    fn prepare(&mut self, inertia: &Matrix3<f64>) -> Result<(), String> {
+        let m = self.tensor;
+        let scale = m.amax();
+        let mu = m.trace() / 3.0;
+        if (m - Matrix3::identity() * mu).amax() <= SHAPE_TOLERANCE * scale {
+            self.shape = Shape::Isotropic(mu);
+            return Ok(());
+        }
+        let body = crate::model::RigidBody::new(*inertia).map_err(|e| e.to_string())?;
+        let [i1, i2, i3] = [
+            body.principal_moments.x,
+            body.principal_moments.y,
+            body.principal_moments.z,
+        ];
+        let tol = SHAPE_TOLERANCE * i3;
+        let (axis, i_s, i_t) = if i3 - i2 <= tol && i2 - i1 > tol {
+            (0, i1, 0.5 * (i2 + i3))
+        } else if i2 - i1 <= tol && i3 - i2 > tol {
+            (2, i3, 0.5 * (i1 + i2))
+        } else {
+            return Err(format!(
+                "its magnetic tensor is not isotropic and the body is not axisymmetric \
+                 (principal moments {i1:.6e}, {i2:.6e}, {i3:.6e} kg m²): the mean torque \
+                 then depends on the joint average of the attitude and the rates over the \
+                 polhode, which is not implemented (an isotropic tensor, such as a spherical \
+                 shell's, or an axisymmetric body with the tensor's axis on its symmetry axis \
+                 can be averaged)"
+            ));
+        };
+        let a = body.principal_axes.column(axis).into_owned();
+        let m_a = (a.transpose() * m * a)[0];
+        let m_t = 0.5 * (m.trace() - m_a);
+        let aa = a * a.transpose();
+        let coaxial = Matrix3::identity() * m_t + aa * (m_a - m_t);
+        if (m - coaxial).amax() > SHAPE_TOLERANCE * scale {
+            return Err(
+                "its magnetic tensor is not axisymmetric about the body's symmetry axis: the \
+                 mean torque then depends on the body's spin about that axis, which is not \
+                 implemented (give the cylinder the body's symmetry axis)"
+                    .into(),
+            );
+        }
+        self.shape = Shape::Coaxial {
+            i_s,
+            i_t,
+            m_t,
+            m_excess: m_a - m_t,
+        };
+        Ok(())
+    }
+
+    fn forcing(&self) -> Option<Forcing> {
+        // A uniform field still turns H, so the direction is carried for it too.
+        Some(self.field.forcing().unwrap_or(Forcing {
+            period: 0.0,
+            window: 0.0,
+        }))
+    }
+
+    fn phase_free(&self) -> bool {
+        // Isotropic M needs ⟨|ω|²⟩ only, constant on an axisymmetric body; a coaxial M sees
+        // the symmetry axis and ω, which move with the precession alone.
+        !matches!(self.shape, Shape::Unprepared)
+    }
+
+    fn rates(&self, motion: &SecularMotion) -> SecularRates {
+        let h = motion.h;
+        if h == 0.0 {
+            return SecularRates::default();
+        }
+        let s = self.field.at(motion.t);
+        let hh = motion.h_hat;
+        let along = 2.0 * motion.energy / h;
+        let (energy_rate, torque) = match self.shape {
+            Shape::Unprepared => (f64::NAN, Vector3::repeat(f64::NAN)),
+            Shape::Isotropic(mu) => {
+                // Inertial ⟨ω ωᵀ⟩ = a Ĥ Ĥᵀ + b (1 − Ĥ Ĥᵀ): ω·Ĥ = 2T/|H| is constant, and the
+                // part across H turns with the precession.
+                let a = along * along;
+                let b = 0.5 * (motion.omega_omega.trace() - a).max(0.0);
+                let (ts, sh) = (s.trace(), (hh.transpose() * s * hh)[0]);
+                let power = mu * (a * (ts - sh) + b * (ts + sh));
+                // ⟨τ⟩ = μ G(S, 1) ⟨ω⟩ = −μ (tr S − S) Ĥ 2T/|H|.
+                (-power, (s * hh - hh * ts) * (mu * along))
+            }
+            Shape::Coaxial {
+                i_s,
+                i_t,
+                m_t,
+                m_excess,
+            } => {
+                // Regular precession: the symmetry axis ẑ on a cone of half-angle θ about Ĥ,
+                // ω = Ĥ |H|/I_t + ẑ ω_s (I_t − I_s)/I_t with ω_s = |H| cos θ / I_s.
+                let x = 2.0 * motion.energy / (h * h);
+                let c2 = ((x - 1.0 / i_t) / (1.0 / i_s - 1.0 / i_t)).clamp(0.0, 1.0);
+                let (c, sn) = (c2.sqrt(), (1.0 - c2).sqrt());
+                let spin = h * c / i_s * (i_t - i_s) / i_t;
+                let e1 = crate::averaging::stepper::perpendicular(&hh);
+                let e2 = hh.cross(&e1);
+                let g_t = field_tensor(&s, &Matrix3::identity()) * m_t;
+                let (mut power, mut torque) = (0.0, Vector3::zeros());
+                for k in 0..CONE_POINTS {
+                    let phi = std::f64::consts::TAU * k as f64 / CONE_POINTS as f64;
+                    let (sp, cp) = phi.sin_cos();
+                    let z = hh * c + (e1 * cp + e2 * sp) * sn;
+                    let omega = hh * (h / i_t) + z * spin;
+                    let g = g_t + field_tensor(&s, &(z * z.transpose())) * m_excess;
+                    let tau = g * omega;
+                    power += tau.dot(&omega);
+                    torque += tau;
+                }
+                let n = CONE_POINTS as f64;
+                (power / n, torque / n)
+            }
+        };
+        let h_rate = torque.dot(&hh);
+        SecularRates {
+            energy_rate,
+            h_rate,
+            dissipation_rate: energy_rate,
+            torque_across: torque - hh * h_rate,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// G(S, M) against the direct sum Σ λ_k [e_k]× M [e_k]× over S's eigenvectors.
+    #[test]
+    fn the_field_tensor_is_the_mean_of_the_cross_products() {
+        let m = Matrix3::new(2.0, 0.3, 0.1, 0.3, 1.0, -0.2, 0.1, -0.2, 0.5);
+        let s = Matrix3::new(1.5, -0.4, 0.2, -0.4, 0.9, 0.3, 0.2, 0.3, 0.7);
+        let eig = s.symmetric_eigen();
+        let mut direct = Matrix3::zeros();
+        for k in 0..3 {
+            let e = eig.eigenvectors.column(k).into_owned();
+            direct += e.cross_matrix() * m * e.cross_matrix() * eig.eigenvalues[k];
+        }
+        assert!((field_tensor(&s, &m) - direct).amax() < 1e-14);
+    }
+}
