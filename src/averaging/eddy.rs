@@ -1,7 +1,7 @@
 //! Eddy-current damping averaged over the torque-free motion and the orbit
 //! (docs/averaging.md, "Eddy currents").
 //!
-//! The torque τ = (M (ω × B)) × B = [B]× M [B]× ω is linear in ω and quadratic in B. When the
+//! The torque τ = (M (ω × B)) × B = \[B\]× M \[B\]× ω is linear in ω and quadratic in B. When the
 //! body turns many times per orbit and the orbit-driven field is independent of the fast
 //! phases (no resonance), the mean over both is the mean over the body's motion of a torque
 //! in which B Bᵀ is replaced by its orbit average S = ⟨B Bᵀ⟩ (inertial axes):
@@ -38,7 +38,7 @@ const SHAPE_TOLERANCE: f64 = 1e-9;
 /// integrate exactly.
 const CONE_POINTS: usize = 8;
 
-/// G(S, M) = ⟨[B]× M [B]×⟩ for ⟨B Bᵀ⟩ = S, both symmetric.
+/// G(S, M) = ⟨\[B\]× M \[B\]×⟩ for ⟨B Bᵀ⟩ = S, both symmetric.
 pub fn field_tensor(s: &Matrix3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
     let (ts, tm) = (s.trace(), m.trace());
     let sm = s * m;

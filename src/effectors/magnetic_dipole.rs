@@ -89,22 +89,27 @@ mod tests {
     use crate::orbit::{CentralBody, Elements};
     use nalgebra::UnitQuaternion;
 
-    /// The square-root-free rotation against nalgebra's, for a quaternion off unit norm by
-    /// 1e-3.
-    #[test]
-    fn the_fast_body_field_equals_the_rotated_field() {
+    /// A dipole on a slightly eccentric, inclined low orbit, in the field of late 2023.
+    fn dipole_on_orbit() -> MagneticDipole {
         let orbit = Orbit::new(
             CentralBody::EARTH,
             Elements::new(6.9e6, 0.01, 0.9, 0.4, 1.1, 0.2),
             false,
         )
         .unwrap();
-        let md = MagneticDipole {
+        MagneticDipole {
             name: "m".into(),
             orbit: Arc::new(orbit),
             field: GeomagneticField::new(1_700_000_000_000_000_000),
             moment: Vector3::new(0.1, -0.2, 0.3),
-        };
+        }
+    }
+
+    /// The square-root-free rotation against nalgebra's, for a quaternion off unit norm by
+    /// 1e-3.
+    #[test]
+    fn the_fast_body_field_equals_the_rotated_field() {
+        let md = dipole_on_orbit();
         let q = UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
         let raw = [q.w * 1.001, q.i * 1.001, q.j * 1.001, q.k * 1.001];
         for t in [0.0, 1234.5, 9876.0] {
@@ -122,18 +127,7 @@ mod tests {
     /// the field rotated by nalgebra, away from 0 and π where acos loses digits.
     #[test]
     fn the_field_angle_is_the_angle_between_moment_and_field() {
-        let orbit = Orbit::new(
-            CentralBody::EARTH,
-            Elements::new(6.9e6, 0.01, 0.9, 0.4, 1.1, 0.2),
-            false,
-        )
-        .unwrap();
-        let md = MagneticDipole {
-            name: "m".into(),
-            orbit: Arc::new(orbit),
-            field: GeomagneticField::new(1_700_000_000_000_000_000),
-            moment: Vector3::new(0.1, -0.2, 0.3),
-        };
+        let md = dipole_on_orbit();
         let q = UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
         let raw = [q.w, q.i, q.j, q.k];
         for t in [0.0, 1234.5, 9876.0] {
