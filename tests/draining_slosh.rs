@@ -12,15 +12,9 @@ mod common;
 
 use common::scenario;
 use polhode::effectors::slosh_analog::{Liquid, Tank, slosh_analog};
-use polhode::scenario::Scenario;
-use polhode::sim::{self, Control, Memory, Outcome, Status};
+use polhode::sim::Status;
 
-/// Runs a scenario, keeping every sample's state vector.
-fn run(s: &Scenario) -> (Outcome, Memory) {
-    let mut memory = Memory::with_states();
-    let outcome = sim::run(s, &mut memory, Control::uninterrupted()).expect("in memory");
-    (outcome, memory)
-}
+use common::run_with_states as run;
 
 const LIQUID: &str = "{density: 1004.0, kinematic_viscosity: 9.7e-7, surface_tension: 0.066}";
 

@@ -12,10 +12,9 @@ use polhode::effectors::eddy_currents::{AmbientField, MU_0};
 use polhode::effectors::hysteresis_rod::{HysteresisLoop, demagnetising_factor};
 use polhode::model::Observation;
 use polhode::scenario::{Overrides, parse};
-use polhode::sim::{self, Control, Memory, Status};
+use polhode::sim::Status;
 use std::f64::consts::{PI, TAU};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 /// Apparent coercivity (A/m), remanence and saturation (T) of the rods in these tests.
 const HC: f64 = 12.0;
@@ -67,17 +66,7 @@ fn spin(h0: f64, duration: f64) -> (Vec<Observation>, Vec<Vec<f64>>) {
             conductor: None,
         }))
         .unwrap();
-    let mut rec = Memory::with_states();
-    let stop = AtomicBool::new(false);
-    let out = sim::run(
-        &s,
-        &mut rec,
-        Control {
-            interrupt: &stop,
-            progress: None,
-        },
-    )
-    .unwrap();
+    let (out, rec) = common::run_with_states(&s);
     assert_eq!(out.status, Status::Complete);
     (rec.samples, rec.states)
 }
@@ -339,17 +328,7 @@ fn in_orbit_the_field_along_the_orbit_drives_the_rod_and_the_balance_closes() {
              coercivity: 12, remanence: 0.35, saturation: 0.74}}\n"
         );
         let s = common::scenario(&yaml);
-        let mut rec = Memory::with_states();
-        let stop = AtomicBool::new(false);
-        let out = sim::run(
-            &s,
-            &mut rec,
-            Control {
-                interrupt: &stop,
-                progress: None,
-            },
-        )
-        .unwrap();
+        let (out, rec) = common::run_with_states(&s);
         assert_eq!(out.status, Status::Complete);
         let b: Vec<f64> = rec.states.iter().map(|y| y[7]).collect();
         let (lo, hi) = b
@@ -468,13 +447,7 @@ fn material_properties_through_the_scenario_file() {
             "{base}effectors:\n  - hysteresis_rod: {{axis: [1, 0, 0], length: 0.095, \
              diameter: 0.001, {loop_keys}}}\n"
         ));
-        let mut rec = Memory::with_states();
-        let stop = AtomicBool::new(false);
-        let control = Control {
-            interrupt: &stop,
-            progress: None,
-        };
-        sim::run(&s, &mut rec, control).unwrap();
+        let (_, rec) = common::run_with_states(&s);
         rec.states.last().unwrap().clone()
     };
     let from_material =
@@ -524,13 +497,7 @@ fn the_rods_eddy_currents_bound_the_model_during_the_run() {
                 0.001, coercivity: 1.59, remanence: 0.35, saturation: 0.73, properties: \
                 material}\n";
     let s = common::scenario(yaml);
-    let mut rec = Memory::with_states();
-    let stop = AtomicBool::new(false);
-    let control = Control {
-        interrupt: &stop,
-        progress: None,
-    };
-    let out = sim::run(&s, &mut rec, control).unwrap();
+    let (out, _) = common::run_with_states(&s);
     let Status::InvalidModel { diagnosis } = &out.status else {
         panic!("{:?}", out.status);
     };
@@ -567,13 +534,7 @@ fn the_field_angle_condition_needs_a_magnet() {
         "{base}effectors:\n  - magnetic_dipole: {{moment: [0, 0, 0.1]}}\nevents:\n  - \
          {{field_angle_deg: {{below: 180}}}}\n"
     ));
-    let mut rec = Memory::with_states();
-    let stop = AtomicBool::new(false);
-    let control = Control {
-        interrupt: &stop,
-        progress: None,
-    };
-    let out = sim::run(&s, &mut rec, control).unwrap();
+    let (out, rec) = common::run_with_states(&s);
     assert_eq!(out.events.len(), 1, "{:?}", out.events);
     let a = rec.samples[0].field_angle;
     assert!(a > 0.0 && a < PI, "{a}");

@@ -54,6 +54,15 @@ pub const SINGULAR_COS_THETA: f64 = 0.05;
 /// singularity: the φ inertia m l² cos² θ has fallen to cos² 75° = 7 % of its value at rest.
 pub const THETA_WARN_DEG: f64 = 75.0;
 
+/// A tank analog's non-sloshing liquid `mass` (kg) at `position` (m, body axes), drawn as a
+/// sphere growing with the cube root of the mass; nothing without one.
+pub(crate) fn fixed_liquid_drawing(mass: f64, position: Vector3<f64>) -> Option<Drawing> {
+    (mass > 0.0).then(|| Drawing::Sphere {
+        center: position,
+        diameter: (mass.cbrt() * 0.05).clamp(0.02, 0.3),
+    })
+}
+
 /// The pendulum frame of a rest direction `p1` (unit, body axes): p̂₃ = p̂₁ × ê_k / |…|, with ê_k
 /// the body axis least aligned with p̂₁ (the first on ties), and p̂₂ = p̂₃ × p̂₁. A rest direction
 /// along body x gives the body axes themselves.
@@ -456,12 +465,7 @@ impl ParticleModel for SloshPendulum {
                 diameter: size,
             },
         ];
-        if self.fixed_mass > 0.0 {
-            drawings.push(Drawing::Sphere {
-                center: self.fixed_position,
-                diameter: (self.fixed_mass.cbrt() * 0.05).clamp(0.02, 0.3),
-            });
-        }
+        drawings.extend(fixed_liquid_drawing(self.fixed_mass, self.fixed_position));
         drawings
     }
 }

@@ -10,6 +10,7 @@
 //! scene without a tank pays nothing for this.
 
 use super::particles::{ParticleModel, ParticlePoint};
+use super::slosh_pendulum::fixed_liquid_drawing;
 use super::spring_mass::SpringMass;
 use crate::model::{Drawing, HubState, Validity};
 use nalgebra::Vector3;
@@ -232,12 +233,7 @@ impl ParticleModel for SloshSpring {
                 diameter: size,
             });
         }
-        if self.fixed_mass > 0.0 {
-            drawings.push(Drawing::Sphere {
-                center: self.fixed_position,
-                diameter: (self.fixed_mass.cbrt() * 0.05).clamp(0.02, 0.3),
-            });
-        }
+        drawings.extend(fixed_liquid_drawing(self.fixed_mass, self.fixed_position));
         drawings
     }
 }

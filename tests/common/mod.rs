@@ -37,6 +37,13 @@ pub fn run(s: &Scenario) -> (Outcome, Recorder) {
     (out, rec)
 }
 
+/// Runs a scenario, keeping samples, events and every sample's state vector.
+pub fn run_with_states(s: &Scenario) -> (Outcome, Recorder) {
+    let mut rec = Recorder::with_states();
+    let out = sim::run(s, &mut rec, Control::uninterrupted()).expect("in-memory sink cannot fail");
+    (out, rec)
+}
+
 /// A rigid-body scenario in YAML from its parts.
 pub fn rigid_yaml(
     principal: [f64; 3],
