@@ -6,7 +6,8 @@
 #
 # Installs cargo-fuzz from crates.io if it is missing. The targets run side by side, one per
 # core (in turn on one core), each with libFuzzer's -max_total_time=SECONDS, -rss_limit_mb=2048
-# and -timeout=10, from the corpus in fuzz/corpus/TARGET (kept between runs, not committed),
+# and -timeout=10 (30 for scenario_loader, see run_target), from the corpus in
+# fuzz/corpus/TARGET (kept between runs, not committed),
 # seeded with scenarios/*.yaml and tests/data/*.yaml. Exits non-zero if a target finds a crash,
 # a hang or an out-of-memory input, printing the input's path and how to reproduce it.
 #
@@ -115,6 +116,13 @@ export POLHODE_FUZZ_TMP="$scratch"
 run_target() {
     local target=$1 log=$2
     local extra=()
+    # Per-input time limit (s), a hang detector. The loader's is longer: in this build (debug
+    # assertions) loading scenarios/liquid-stage-burn.yaml, whose draining tanks fit their fill
+    # curves from 24 slosh-analog solutions each, takes about 13 s (0.8 s in release).
+    local timeout=10
+    if [[ $target == scenario_loader ]]; then
+        timeout=30
+    fi
     if [[ $target == writers ]]; then
         # Structured input: long inputs from the start (a logged sample alone is ~200 bytes).
         extra=(-max_len=8192 -len_control=0)
@@ -128,7 +136,7 @@ run_target() {
     # The binary cargo fuzz built, run as `cargo fuzz run` would (which would first check the
     # build again, and rebuild if the sources changed meanwhile).
     (cd "$fuzz_dir" && "$bin_dir/$target" -artifact_prefix="artifacts/$target/" \
-        -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
+        -max_total_time="$seconds" -rss_limit_mb=2048 -timeout="$timeout" -print_final_stats=1 \
         "${extra[@]}" "corpus/$target") >"$log" 2>&1
 }
 
