@@ -14,20 +14,9 @@
 //! convolved with one sidereal day ([`FieldMoments`]), sampled every two days and
 //! interpolated.
 
+pub use super::field_moments::FieldMoments;
 use crate::model::{Forcing, Secular, SecularMotion, SecularRates};
-use crate::orbit::{GeomagneticField, Orbit};
 use nalgebra::{Matrix3, Vector3};
-use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
-
-/// The sidereal day (s): the period of the Earth's rotation against the stars.
-pub const SIDEREAL_DAY: f64 = 86_164.090_5;
-
-/// Spacing of the windows at which S is computed (s): two days.
-pub const WINDOW_SPACING: f64 = 2.0 * 86_400.0;
-
-/// Field samples per orbit in a window's quadrature.
-pub const SAMPLES_PER_ORBIT: usize = 16;
 
 /// Relative tolerance within which the body is taken as axisymmetric and M as axisymmetric
 /// about its symmetry axis, or isotropic.
@@ -43,116 +32,6 @@ pub fn field_tensor(s: &Matrix3<f64>, m: &Matrix3<f64>) -> Matrix3<f64> {
     let (ts, tm) = (s.trace(), m.trace());
     let sm = s * m;
     m * ts + s * tm - sm - sm.transpose() - Matrix3::identity() * (ts * tm - sm.trace())
-}
-
-/// The orbit-averaged second moment S(t) = ⟨B Bᵀ⟩ (T², inertial axes) of the field the body
-/// turns in.
-#[derive(Debug)]
-pub enum FieldMoments {
-    /// A field constant in inertial axes: S = B Bᵀ.
-    Uniform(Matrix3<f64>),
-    /// The geomagnetic field along an orbit, windowed and interpolated.
-    Orbit {
-        /// The orbit.
-        orbit: Arc<Orbit>,
-        /// The field model.
-        field: GeomagneticField,
-        /// Windows computed so far, by index (window k is centred at k·[`WINDOW_SPACING`]).
-        cache: Mutex<HashMap<i64, Matrix3<f64>>>,
-        /// The first and last window inside the field model's years: beyond them S is held
-        /// (a slow stepper's trial stage may look past the end of the run).
-        windows: (i64, i64),
-    },
-}
-
-impl FieldMoments {
-    /// The geomagnetic field along `orbit`.
-    pub fn orbit(orbit: Arc<Orbit>, field: GeomagneticField) -> FieldMoments {
-        let (first, last) = field.years();
-        let year = 365.25 * 86_400.0;
-        let half = 0.5 * (SIDEREAL_DAY + orbit.period()) + WINDOW_SPACING;
-        let lo = (first - field.year(0.0)) * year + half;
-        let hi = (last - field.year(0.0)) * year - half;
-        let windows = (
-            (lo / WINDOW_SPACING).ceil() as i64,
-            (hi / WINDOW_SPACING).floor() as i64,
-        );
-        FieldMoments::Orbit {
-            orbit,
-            field,
-            cache: Mutex::new(HashMap::new()),
-            windows,
-        }
-    }
-
-    /// The forcing periods, for a field that depends on the orbit.
-    pub fn forcing(&self) -> Option<Forcing> {
-        match self {
-            FieldMoments::Uniform(_) => None,
-            FieldMoments::Orbit { orbit, .. } => Some(Forcing {
-                period: orbit.period(),
-                window: SIDEREAL_DAY + orbit.period(),
-            }),
-        }
-    }
-
-    /// S at `t` (s): for the orbit, the cubic (Catmull–Rom) interpolant of the window means.
-    pub fn at(&self, t: f64) -> Matrix3<f64> {
-        match self {
-            FieldMoments::Uniform(s) => *s,
-            FieldMoments::Orbit {
-                orbit,
-                field,
-                cache,
-                windows,
-            } => {
-                let x = t / WINDOW_SPACING;
-                let k = x.floor();
-                let u = x - k;
-                let k = k as i64;
-                let mut cache = cache.lock().unwrap_or_else(|e| e.into_inner());
-                let mut get = |j: i64| {
-                    let j = j.clamp(windows.0, windows.1.max(windows.0));
-                    *cache
-                        .entry(j)
-                        .or_insert_with(|| window_mean(orbit, field, j as f64 * WINDOW_SPACING))
-                };
-                let (p0, p1, p2, p3) = (get(k - 1), get(k), get(k + 1), get(k + 2));
-                let (u2, u3) = (u * u, u * u * u);
-                (p1 * 2.0
-                    + (p2 - p0) * u
-                    + (p0 * 2.0 - p1 * 5.0 + p2 * 4.0 - p3) * u2
-                    + (p1 * 3.0 - p0 - p2 * 3.0 + p3) * u3)
-                    * 0.5
-            }
-        }
-    }
-}
-
-/// The mean of B Bᵀ (T², inertial axes) about `centre` (s), weighted by a box of one orbit
-/// period P convolved with a box of one sidereal day D (a trapezoid of base P + D): it removes
-/// the harmonics of the orbit (to first order in the Earth's rotation over one orbit) and of
-/// the day. Both boxes are rounded to whole samples, P/[`SAMPLES_PER_ORBIT`] apart, so the
-/// weight's corners fall on samples and the composite trapezoid rule is exact for it.
-pub fn window_mean(orbit: &Orbit, field: &GeomagneticField, centre: f64) -> Matrix3<f64> {
-    let p = orbit.period();
-    let step = p / SAMPLES_PER_ORBIT as f64;
-    let np = SAMPLES_PER_ORBIT as i64;
-    let nd = (SIDEREAL_DAY / step).round() as i64;
-    let half = (np + nd) / 2;
-    let mut sum = Matrix3::zeros();
-    let mut weights = 0.0;
-    for i in -half..=half {
-        // The trapezoid: 1 on the plateau, falling linearly to 0 at ±(P + D)/2.
-        let w = ((half - i.abs()) as f64 / np as f64).clamp(0.0, 1.0);
-        if w == 0.0 {
-            continue;
-        }
-        let b = field.field_on_orbit(orbit, centre + i as f64 * step);
-        sum += b * b.transpose() * w;
-        weights += w;
-    }
-    sum / weights
 }
 
 /// How the torque is averaged over the body's motion.

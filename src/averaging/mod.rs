@@ -10,6 +10,7 @@
 //!   solution for sampling, events and logs.
 
 pub mod eddy;
+pub mod field_moments;
 pub mod forced;
 pub mod motion;
 pub mod stepper;
