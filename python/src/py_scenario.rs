@@ -8,7 +8,7 @@ use crate::{DICT_SOURCE_NAME, TEXT_SOURCE_NAME};
 use polhode::scenario::{self, Overrides};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyString};
+use pyo3::types::{PyBool, PyInt, PyString};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -305,7 +305,12 @@ fn real(name: &str, expected: &str, value: Option<Bound<'_, PyAny>>) -> PyResult
     if v.is_instance_of::<PyBool>() {
         return Err(type_error("run", name, expected, &v));
     }
-    v.extract::<f64>()
-        .map(Some)
-        .map_err(|_| type_error("run", name, expected, &v))
+    v.extract::<f64>().map(Some).map_err(|e| {
+        // An int too large for a float keeps Python's own OverflowError: its type is right.
+        if v.is_instance_of::<PyInt>() {
+            e
+        } else {
+            type_error("run", name, expected, &v)
+        }
+    })
 }

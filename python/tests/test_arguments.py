@@ -137,6 +137,12 @@ def test_numbers_of_every_kind_are_taken():
     assert len(scenario.run(duration=np.int64(1)).t) == 101
 
 
+def test_an_int_too_large_for_a_float_is_an_overflow_error():
+    # Its type is right: Python's own error (int too large to convert to float), not a TypeError.
+    with pytest.raises(OverflowError):
+        racket().run(duration=10**400)
+
+
 def test_negative_counts_are_value_errors_naming_the_argument():
     with pytest.raises(ValueError, match=r"^montecarlo\(\): runs must be at least 0, got -3$"):
         polhode.montecarlo(SINK, runs=-3)
