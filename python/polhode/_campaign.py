@@ -9,26 +9,19 @@ scenario, seed and shard: the extension runs the campaign with the CLI's library
 from __future__ import annotations
 
 import json
+import numbers
+import os
 import sys
 from typing import TYPE_CHECKING, Any, Callable, Optional, Tuple, Union
 
-from ._polhode import Scenario, _montecarlo
+from ._args import integer, is_path, optional_import, type_error
+from ._polhode import Scenario, _montecarlo, load
 
 if TYPE_CHECKING:
     import pandas
     import pyarrow
 
 __all__ = ["Campaign", "montecarlo"]
-
-
-def _import(module, what):
-    try:
-        return __import__(module, fromlist=["_"])
-    except ImportError as e:
-        raise ImportError(
-            f"{what} needs {module.split('.')[0]}, which is not installed: "
-            f"`pip install {module.split('.')[0]}` ({e})"
-        ) from e
 
 
 class Campaign:
@@ -58,8 +51,8 @@ class Campaign:
     def table(self) -> pyarrow.Table:
         """The runs as a ``pyarrow.Table`` (pyarrow imported on first use)."""
         if self._table is None:
-            pa = _import("pyarrow", "Campaign.table")
-            pq = _import("pyarrow.parquet", "Campaign.table")
+            pa = optional_import("pyarrow", "Campaign.table")
+            pq = optional_import("pyarrow.parquet", "Campaign.table")
             # Read from a copy in an Arrow-owned buffer, not from the Python bytes: a table
             # whose columns still point into a Python object aborts the interpreter at exit
             # ("terminate called without an active exception", as in apache/arrow#34314;
@@ -71,7 +64,7 @@ class Campaign:
 
     def to_pandas(self) -> pandas.DataFrame:
         """The runs as a pandas DataFrame (needs pyarrow and pandas)."""
-        _import("pandas", "Campaign.to_pandas()")
+        optional_import("pandas", "Campaign.to_pandas()")
         return self.table.to_pandas()
 
     @property
@@ -132,6 +125,10 @@ def _progress(progress, description):
     """The progress callback for ``progress=`` (None: auto), and how to close it."""
     if progress is False:
         return None
+    if not (progress is None or progress is True or callable(progress)):
+        raise type_error(
+            "montecarlo", "progress", "True, False, None or a callable f(done, total)", progress
+        )
     if callable(progress) and progress is not True:
         return progress
     if progress is None and not (_stderr_is_terminal() or _in_jupyter()):
@@ -147,9 +144,15 @@ def _progress(progress, description):
     return _Bar(tqdm, description)
 
 
+# What montecarlo's shard= takes, in its TypeError.
+_SHARD_EXPECTED = "'K/N' (str) or a pair (K, N) of ints"
+
+
 def _shard(shard):
     if shard is None:
         return None
+    if not isinstance(shard, (str, tuple, list)):
+        raise type_error("montecarlo", "shard", _SHARD_EXPECTED, shard)
     if isinstance(shard, str):
         k, sep, n = shard.partition("/")
         try:
@@ -158,15 +161,17 @@ def _shard(shard):
             return int(k), int(n)
         except ValueError:
             raise ValueError(f"shard {shard!r}: expected 'K/N' or (K, N), e.g. '2/8'") from None
-    try:
-        k, n = shard
-        return int(k), int(n)
-    except (TypeError, ValueError):
-        raise ValueError(f"shard {shard!r}: expected 'K/N' or (K, N), e.g. '2/8'") from None
+    if len(shard) != 2:
+        raise ValueError(f"shard {shard!r}: expected 'K/N' or (K, N), e.g. '2/8'")
+    for part in shard:
+        if isinstance(part, bool) or not isinstance(part, numbers.Integral):
+            raise type_error("montecarlo", "shard", _SHARD_EXPECTED, shard)
+    k, n = shard
+    return int(k), int(n)
 
 
 def montecarlo(
-    scenario: Scenario,
+    scenario: Union[Scenario, str, os.PathLike],
     runs: Optional[int] = None,
     seed: Optional[int] = None,
     threads: Optional[int] = None,
@@ -176,8 +181,9 @@ def montecarlo(
 ) -> Campaign:
     """Run the scenario's Monte Carlo campaign (its ``montecarlo:`` block) in process.
 
-    The same runs, table and summary as ``polhode montecarlo FILE --runs R --seed S
-    --shard K/N`` (any thread count gives the same numbers).
+    ``scenario`` is a :class:`Scenario` or a scenario file's path (str or os.PathLike),
+    loaded as :func:`load` does. The same runs, table and summary as ``polhode montecarlo
+    FILE --runs R --seed S --shard K/N`` (any thread count gives the same numbers).
 
     - ``runs``, ``seed``: override the block's; ``threads``: worker threads (default: every
       core; more than 4 per logical core are capped there, with a ``RuntimeWarning``); ``shard``: ``"K/N"`` or ``(K, N)``, 1 <= K <= N, to run only the K-th of N
@@ -193,8 +199,25 @@ def montecarlo(
     campaign within a fraction of a second and raises ``KeyboardInterrupt`` whose
     ``partial`` attribute is the :class:`Campaign` of the runs that finished.
     Raises ``ScenarioError`` when the scenario has no valid ``montecarlo:`` block or
-    ``runs`` is out of range, ``ValueError`` for a bad ``shard`` or ``threads``.
+    ``runs`` is out of range, ``ValueError`` for a bad ``shard`` or ``threads``, and
+    ``TypeError`` naming the argument for one of the wrong type.
     """
+    if is_path(scenario):
+        scenario = load(scenario)
+    elif not isinstance(scenario, Scenario):
+        raise type_error(
+            "montecarlo",
+            "scenario",
+            "a Scenario or a scenario file's path (str or os.PathLike)",
+            scenario,
+        )
+    runs = integer("montecarlo", "runs", "a number of runs (int)", runs, 0)
+    seed = integer("montecarlo", "seed", "a seed (int)", seed, 0)
+    threads = integer("montecarlo", "threads", "a number of threads (int)", threads, 0)
+    if method is not None and not isinstance(method, str):
+        raise type_error(
+            "montecarlo", "method", "an integration method's name (str, e.g. \"averaged\")", method
+        )
     pair = _shard(shard)
     name = getattr(scenario, "name", "montecarlo")
     report = _progress(progress, name)

@@ -12,7 +12,7 @@ so that the loader sees what Python holds:
   ``- `` items, so the loader can name the field of an error (``effectors[0].mass``).
 
 Anything else (a set, bytes, a complex number, an arbitrary object) raises ``ScenarioError``
-naming its field.
+naming its field; a ``d`` that is not a mapping at all raises ``TypeError``.
 """
 
 import json
@@ -20,6 +20,7 @@ import math
 import re
 from collections.abc import Mapping
 
+from ._args import type_error
 from ._polhode import ScenarioError
 
 __all__ = ["to_yaml"]
@@ -161,10 +162,11 @@ def to_yaml(scenario):
     """``(text, fields)``: the scenario dict as YAML, and the dotted field of each line."""
     scenario = _plain(scenario)
     if not isinstance(scenario, Mapping):
-        raise _error(
-            None,
-            f"expected a dict of the scenario's top-level keys (name, body, initial, "
-            f"duration, ...), got a {type(scenario).__name__}",
+        raise type_error(
+            "Scenario.from_dict",
+            "d",
+            "a dict of the scenario's top-level keys (name, body, initial, duration, ...)",
+            scenario,
         )
     lines, fields = [], []
     _block(scenario, "", 0, lines, fields)

@@ -52,11 +52,27 @@ class Result:
     @property
     def status(self) -> str:
         """complete, stopped, interrupted, failed or invalid_model."""
-    def to_pandas(self) -> Any:
-        """A ``pandas.DataFrame``: ``t`` (s), then every ``telemetry`` column (same units).
+    @property
+    def units(self) -> Dict[str, str]:
+        """The unit of each ``telemetry`` column by name (``"rad/s"``; ``""`` for none)."""
+    def to_pandas(self, units: bool = True) -> Any:
+        """A ``pandas.DataFrame``, one column per ``telemetry`` column in its order, one row
+        per sample (a copy).
 
-        Imports pandas (not a dependency of polhode; ImportError saying so when missing).
+        Columns named as the ``polhode run --csv`` header names them (``sim_time [s]``,
+        ``omega_x [rad/s]``, ``damper.offset [m]``), or by the bare ``telemetry`` names with
+        ``units=False``. Imports pandas (not a dependency of polhode; ImportError saying what
+        to install when missing).
         """
+    def plot(self, figsize: Optional[Tuple[float, float]] = None) -> Any:
+        """A ``matplotlib.figure.Figure`` (made with pyplot) of four panels against sim time:
+        the body rates (rad/s), the nutation angle (deg), the kinetic, elastic (when not
+        zero) and dissipated energies (J), and the relative drift of |H|; events as dashed
+        lines. ``figsize`` in inches, (8, 9) by default. Imports matplotlib (ImportError
+        saying what to install when missing).
+        """
+    def _repr_html_(self) -> str:
+        """Jupyter's view: status, method, duration, drift, work counters and events."""
 
 class Scenario:
     """A validated scenario."""
@@ -85,8 +101,10 @@ class Scenario:
         Validated by the CLI's loader; ``ScenarioError`` with ``path="<dict>"``, ``field``
         the dotted field (``body.inertia``, ``effectors[0].mass``), ``line``/``column``
         None, for wrong types, NaN/inf, unknown keys, wrong shapes and values YAML cannot
-        hold (sets, objects).
+        hold (sets, objects); TypeError when ``d`` is not a mapping.
         """
+    def _repr_html_(self) -> str:
+        """Jupyter's view: name, file, method and duration."""
     def run(
         self,
         method: Optional[str] = None,
@@ -102,16 +120,18 @@ class Scenario:
         scenario's; ``log`` names the MCAP file to write (none is written without it).
         Releases the GIL; Ctrl-C raises KeyboardInterrupt within 0.1 s.
         Raises ScenarioError when an override does not validate, OSError when the log
-        cannot be written.
+        cannot be written, TypeError naming the argument for one of the wrong type.
         """
 
-def linearize(scenario: Scenario) -> Dict[str, Any]:
+def linearize(scenario: Union[Scenario, str, "PathLike[str]"]) -> Dict[str, Any]:
     """The JSON of ``polhode linearize FILE --json OUT`` as a dict (docs/cli.md).
+
+    ``scenario`` is a Scenario or a scenario file's path (loaded as :func:`load` does).
 
     Modes about the steady spin (eigenvalues in 1/s, time constants in s), or about the LVLH
     equilibrium for a gravity-gradient spacecraft in orbit, or the effectors' modes under a
     driven hub. Raises ScenarioError, or ValueError with the CLI's message when the scenario
-    cannot be linearised.
+    cannot be linearised, TypeError when ``scenario`` is neither.
     """
 
 def _montecarlo(
@@ -127,7 +147,9 @@ def _montecarlo(
     ``summary.json`` text, whether runs are missing, and the exception raised meanwhile."""
 
 def load(path: Union[str, "PathLike[str]"]) -> Scenario:
-    """Read and validate a scenario file (YAML); raises ScenarioError."""
+    """Read and validate a scenario file (YAML); raises ScenarioError, or TypeError when
+    ``path`` is not a str or os.PathLike."""
 
 def loads(yaml_text: str) -> Scenario:
-    """Validate a scenario given as YAML text; raises ScenarioError."""
+    """Validate a scenario given as YAML text; raises ScenarioError, or TypeError when
+    ``yaml_text`` is not a str."""

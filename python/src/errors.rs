@@ -1,9 +1,11 @@
 //! The exceptions Python sees: `ScenarioError` with its location, `RuntimeError` for an
-//! internal error, `ImportError` for a missing optional package.
+//! internal error, `TypeError` for an argument of the wrong type (the
+//! `ImportError`s for missing optional packages are raised by `polhode/_display.py` and
+//! `polhode/_campaign.py`).
 
 use polhode::scenario::{self};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyImportError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use std::any::Any;
 
@@ -49,21 +51,31 @@ pub(crate) fn internal_error(what: &str, payload: &(dyn Any + Send)) -> PyErr {
     ))
 }
 
-/// `module`, imported, or an `ImportError` saying what needs it and how to install it.
-pub(crate) fn import_optional<'py>(
-    py: Python<'py>,
-    module: &str,
-    what: &str,
-) -> PyResult<Bound<'py, PyModule>> {
-    py.import(module).map_err(|e| {
-        if e.is_instance_of::<PyImportError>(py) {
-            PyImportError::new_err(format!(
-                "{what} needs {module}, which is not installed: `pip install {module}` \
-                 ({})",
-                e.value(py)
-            ))
-        } else {
-            e
-        }
-    })
+/// Longest `repr` of a wrong argument quoted in a `TypeError` (characters).
+const REPR_CHARS: usize = 60;
+
+/// A `TypeError` naming the function, the argument and what it takes:
+/// `run(): duration must be a number of seconds (float), got str '100'`
+/// (the same words as `polhode/_args.py` writes for the Python-side functions).
+pub(crate) fn type_error(
+    function: &str,
+    argument: &str,
+    expected: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyErr {
+    let kind = value
+        .get_type()
+        .name()
+        .map_or_else(|_| "an object".to_string(), |n| n.to_string());
+    let shown = value
+        .repr()
+        .map_or_else(|_| "?".to_string(), |r| r.to_string());
+    let shown = if shown.chars().count() > REPR_CHARS {
+        format!("{}…", shown.chars().take(REPR_CHARS).collect::<String>())
+    } else {
+        shown
+    };
+    PyTypeError::new_err(format!(
+        "{function}(): {argument} must be {expected}, got {kind} {shown}"
+    ))
 }

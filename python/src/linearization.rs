@@ -1,7 +1,7 @@
 //! `polhode.linearize`: the CLI's `linearize --json` document.
 
 use crate::errors::{internal_error, scenario_error};
-use crate::py_scenario::PyScenario;
+use crate::py_scenario::scenario_argument;
 use polhode::scenario::{self, Overrides};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -12,11 +12,12 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 /// equilibrium for a gravity-gradient spacecraft in orbit, or the effectors' modes under a
 /// driven hub (docs/cli.md has the fields and units).
 ///
-/// Raises `ScenarioError` when the scenario no longer validates, `ValueError` with the CLI's
-/// message when it cannot be linearised.
+/// `scenario` is a `Scenario` or a scenario file's path (`str` or `os.PathLike`). Raises
+/// `ScenarioError` when the scenario does not validate, `ValueError` with the CLI's message
+/// when it cannot be linearised, `TypeError` when `scenario` is neither.
 #[pyfunction]
-pub(crate) fn linearize(py: Python<'_>, scenario: PyRef<'_, PyScenario>) -> PyResult<Py<PyAny>> {
-    let (path, source) = (scenario.path.clone(), scenario.source.clone());
+pub(crate) fn linearize(py: Python<'_>, scenario: &Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+    let (path, source) = scenario_argument(py, "linearize", scenario)?;
     let analysed = catch_unwind(AssertUnwindSafe(|| {
         scenario::parse(&path, source, &Overrides::default())
             .map(|s| polhode::cli::linearize_json(&s))

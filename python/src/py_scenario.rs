@@ -1,13 +1,14 @@
 //! `Scenario`: `load`, `loads`, `Scenario.from_dict` and `Scenario.run`.
 
 use crate::detach::run_detached;
-use crate::errors::{internal_error, scenario_error};
+use crate::errors::{internal_error, scenario_error, type_error};
 use crate::result::RunResult;
 use crate::run::{RunError, execute};
 use crate::{DICT_SOURCE_NAME, TEXT_SOURCE_NAME};
 use polhode::scenario::{self, Overrides};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyInt, PyString};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -57,20 +58,71 @@ pub(crate) fn validate(
     }
 }
 
-/// Reads and validates a scenario file (YAML).
+/// What a scenario file's path argument takes.
+const PATH_EXPECTED: &str = "a scenario file's path (str or os.PathLike)";
+
+/// A path argument (`str` or `os.PathLike`), or a `TypeError` naming `function` and
+/// `argument` and saying what `expected` is.
+pub(crate) fn path_argument(
+    function: &str,
+    argument: &str,
+    expected: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<PathBuf> {
+    value
+        .extract::<PathBuf>()
+        .map_err(|_| type_error(function, argument, expected, value))
+}
+
+/// The scenario a `Scenario` or a file's path (loaded and validated) argument names, as a
+/// `(path, YAML text)` pair, or a `TypeError` naming `function` and `scenario`.
+pub(crate) fn scenario_argument(
+    py: Python<'_>,
+    function: &str,
+    value: &Bound<'_, PyAny>,
+) -> PyResult<(PathBuf, String)> {
+    if let Ok(s) = value.cast::<PyScenario>() {
+        let s = s.get();
+        return Ok((s.path.clone(), s.source.clone()));
+    }
+    let path = path_argument(
+        function,
+        "scenario",
+        "a Scenario or a scenario file's path (str or os.PathLike)",
+        value,
+    )?;
+    let s = validate(py, &path, None)?;
+    Ok((s.path, s.source))
+}
+
+/// Reads and validates a scenario file (YAML); `path` is a `str` or an `os.PathLike`.
 ///
-/// Raises `ScenarioError` (a `ValueError`) with the CLI's message when it does not validate.
+/// Raises `ScenarioError` (a `ValueError`) with the CLI's message when it does not validate,
+/// `TypeError` when `path` is not a path.
 #[pyfunction]
-pub(crate) fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScenario> {
+pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<PyScenario> {
+    let path = path_argument("load", "path", PATH_EXPECTED, path)?;
     validate(py, &path, None)
 }
 
-/// Validates a scenario given as YAML text; messages name it `<string>`.
+/// Validates a scenario given as YAML text (a `str`); messages name it `<string>`.
 ///
-/// Raises `ScenarioError` (a `ValueError`) with the CLI's message when it does not validate.
+/// Raises `ScenarioError` (a `ValueError`) with the CLI's message when it does not validate,
+/// `TypeError` when `yaml_text` is not a `str`.
 #[pyfunction]
-pub(crate) fn loads(py: Python<'_>, yaml_text: String) -> PyResult<PyScenario> {
-    validate(py, Path::new(TEXT_SOURCE_NAME), Some(yaml_text))
+pub(crate) fn loads(py: Python<'_>, yaml_text: &Bound<'_, PyAny>) -> PyResult<PyScenario> {
+    let text = yaml_text
+        .cast::<PyString>()
+        .map_err(|_| {
+            type_error(
+                "loads",
+                "yaml_text",
+                "the scenario's YAML text (str)",
+                yaml_text,
+            )
+        })?
+        .extract::<String>()?;
+    validate(py, Path::new(TEXT_SOURCE_NAME), Some(text))
 }
 
 #[pymethods]
@@ -140,6 +192,12 @@ impl PyScenario {
         &self.source
     }
 
+    /// An HTML summary for Jupyter (name, file, method, duration): `polhode/_display.py`.
+    fn _repr_html_(slf: &Bound<'_, Self>) -> PyResult<Py<PyAny>> {
+        let display = slf.py().import("polhode._display")?;
+        Ok(display.call_method1("scenario_html", (slf,))?.unbind())
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Scenario(name={:?}, path={:?}, method={:?}, duration={} s)",
@@ -162,13 +220,37 @@ impl PyScenario {
     fn run(
         &self,
         py: Python<'_>,
-        method: Option<String>,
+        method: Option<Bound<'_, PyAny>>,
         dt: Option<Bound<'_, PyAny>>,
         rtol: Option<Bound<'_, PyAny>>,
         atol: Option<Bound<'_, PyAny>>,
         duration: Option<Bound<'_, PyAny>>,
-        log: Option<PathBuf>,
+        log: Option<Bound<'_, PyAny>>,
     ) -> PyResult<RunResult> {
+        let method = method
+            .map(|m| {
+                m.cast::<PyString>()
+                    .map_err(|_| {
+                        type_error(
+                            "run",
+                            "method",
+                            "an integration method's name (str, e.g. \"dop853\")",
+                            &m,
+                        )
+                    })
+                    .and_then(|m| m.extract::<String>())
+            })
+            .transpose()?;
+        let log = log
+            .map(|l| {
+                path_argument(
+                    "run",
+                    "log",
+                    "the path of the MCAP file to write (str or os.PathLike)",
+                    &l,
+                )
+            })
+            .transpose()?;
         // Checked before the run starts, not after it has been integrated.
         if let Some(p) = &log
             && p.as_os_str().is_empty()
@@ -181,10 +263,10 @@ impl PyScenario {
         let write_log = log.is_some();
         let overrides = Overrides {
             method,
-            dt: real("dt", dt)?,
-            rtol: real("rtol", rtol)?,
-            atol: real("atol", atol)?,
-            duration: real("duration", duration)?,
+            dt: real("dt", "a step in seconds (float)", dt)?,
+            rtol: real("rtol", "a relative tolerance (float)", rtol)?,
+            atol: real("atol", "an absolute tolerance (float)", atol)?,
+            duration: real("duration", "a number of seconds (float)", duration)?,
             mcap: log,
             ..Overrides::default()
         };
@@ -215,22 +297,20 @@ impl PyScenario {
     }
 }
 
-/// An optional real-valued keyword argument: a float or an int, not a bool (`True` is an int
-/// to Python, but `duration=True` is a mistake, as `from_dict` already says).
-fn real(name: &str, value: Option<Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
+/// An optional real-valued keyword argument of `run`: a float or an int (or anything with
+/// `__float__`, as numpy's scalars), not a bool (`True` is an int to Python, but
+/// `duration=True` is a mistake, as `from_dict` already says) and not text.
+fn real(name: &str, expected: &str, value: Option<Bound<'_, PyAny>>) -> PyResult<Option<f64>> {
     let Some(v) = value else { return Ok(None) };
-    if v.is_instance_of::<pyo3::types::PyBool>() {
-        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-            "{name}: expected a number, got the boolean {}",
-            if v.is_truthy()? { "True" } else { "False" }
-        )));
+    if v.is_instance_of::<PyBool>() {
+        return Err(type_error("run", name, expected, &v));
     }
-    v.extract::<f64>().map(Some).map_err(|_| {
-        pyo3::exceptions::PyTypeError::new_err(format!(
-            "{name}: expected a number, got {}",
-            v.get_type()
-                .name()
-                .map_or_else(|_| "another type".to_string(), |n| n.to_string())
-        ))
+    v.extract::<f64>().map(Some).map_err(|e| {
+        // An int too large for a float keeps Python's own OverflowError: its type is right.
+        if v.is_instance_of::<PyInt>() {
+            e
+        } else {
+            type_error("run", name, expected, &v)
+        }
     })
 }

@@ -1,6 +1,5 @@
 //! `Result`: a run's arrays (views of one Rust-owned buffer), events and summary.
 
-use crate::errors::import_optional;
 use crate::run::Products;
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
@@ -35,6 +34,10 @@ pub(crate) struct RunResult {
     /// How the run ended: complete, stopped, interrupted, failed or invalid_model.
     #[pyo3(get)]
     pub(crate) status: String,
+    /// The unit of each `telemetry` column by name (`"rad/s"`; `""` when it has none), as
+    /// the `polhode run --csv` header carries them.
+    #[pyo3(get)]
+    pub(crate) units: Py<PyDict>,
 }
 
 /// Rows of the `omega_*` and `q_*` columns in [`telemetry::FIELDS`].
@@ -54,8 +57,10 @@ impl RunResult {
         let omega = rows_t(OMEGA_ROWS)?;
         let q = rows_t(Q_ROWS)?;
         let telemetry = PyDict::new(py);
-        for (k, name) in p.names.iter().enumerate() {
+        let units = PyDict::new(py);
+        for (k, (name, unit)) in p.names.iter().zip(&p.units).enumerate() {
             telemetry.set_item(name, block.get_item(k)?)?;
+            units.set_item(name, unit)?;
         }
         let events = PyList::empty(py);
         for e in &p.outcome.events {
@@ -76,6 +81,7 @@ impl RunResult {
             events: events.unbind(),
             summary: summary.unbind(),
             status: p.outcome.status.label().to_string(),
+            units: units.unbind(),
         })
     }
 }
@@ -91,17 +97,27 @@ impl RunResult {
         )
     }
 
-    /// A pandas DataFrame: `t` (s), then every column of `telemetry` (units as there).
-    ///
-    /// pandas is imported here (not a dependency of polhode): `ImportError` when missing.
-    /// The DataFrame holds a copy of the arrays.
-    fn to_pandas(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        let pandas = import_optional(py, "pandas", "Result.to_pandas()")?;
-        let data = PyDict::new(py);
-        data.set_item("t", self.t.bind(py))?;
-        for (name, column) in self.telemetry.bind(py).iter() {
-            data.set_item(name, column)?;
-        }
-        Ok(pandas.getattr("DataFrame")?.call1((data,))?.unbind())
+    /// A pandas DataFrame of the samples, a column per `telemetry` column in its order, named
+    /// as the `polhode run --csv` header names them (`omega_x [rad/s]`), or by the bare names
+    /// with `units=False`: `polhode/_display.py`. A copy; pandas is imported here
+    /// (`ImportError` saying what to install when missing).
+    #[pyo3(signature = (units=None), text_signature = "($self, units=True)")]
+    fn to_pandas(slf: &Bound<'_, Self>, units: Option<&Bound<'_, PyAny>>) -> PyResult<Py<PyAny>> {
+        let display = slf.py().import("polhode._display")?;
+        Ok(display.call_method1("to_pandas", (slf, units))?.unbind())
+    }
+
+    /// A matplotlib Figure of the usual series (body rates, nutation angle, energies, |H|
+    /// drift) against time: `polhode/_display.py`. matplotlib is imported here.
+    #[pyo3(signature = (figsize=None))]
+    fn plot(slf: &Bound<'_, Self>, figsize: Option<&Bound<'_, PyAny>>) -> PyResult<Py<PyAny>> {
+        let display = slf.py().import("polhode._display")?;
+        Ok(display.call_method1("plot", (slf, figsize))?.unbind())
+    }
+
+    /// An HTML summary for Jupyter (status, method, duration, drift, work, events).
+    fn _repr_html_(slf: &Bound<'_, Self>) -> PyResult<Py<PyAny>> {
+        let display = slf.py().import("polhode._display")?;
+        Ok(display.call_method1("result_html", (slf,))?.unbind())
     }
 }

@@ -117,6 +117,8 @@ impl Sink for Collector<'_> {
 pub(crate) struct Products {
     /// Column names: the `/telemetry` fields, then `<effector>.<field>`.
     pub(crate) names: Vec<String>,
+    /// Each column's unit (`rad/s`; `""` when it has none), as the `--csv` header gives it.
+    pub(crate) units: Vec<String>,
     /// The columns back to back, `n` values each.
     pub(crate) columns: Vec<f64>,
     /// Output samples.
@@ -158,10 +160,10 @@ pub(crate) fn execute(
             .check()
             .map_err(RunError::Refused)?;
     }
-    let names: Vec<String> = samples::columns(&s.spacecraft)
+    let (names, units): (Vec<String>, Vec<String>) = samples::columns(&s.spacecraft)
         .into_iter()
-        .map(|c| c.name)
-        .collect();
+        .map(|c| (c.name, c.unit))
+        .unzip();
     // Known before anything is allocated or integrated: refused with the numbers.
     polhode::resources::check_sample_memory(
         &format!("{}: the run's samples", s.path.display()),
@@ -238,6 +240,7 @@ pub(crate) fn execute(
     let n = collector.store.len;
     Ok(Products {
         names,
+        units,
         columns: collector.store.into_columns(),
         n,
         outcome,

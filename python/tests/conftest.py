@@ -9,6 +9,10 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 
+# Matplotlib draws without a window in the tests, and in the kernels they start (the example
+# notebook's), which inherit this environment.
+os.environ["MPLBACKEND"] = "Agg"
+
 
 @pytest.fixture(scope="session")
 def polhode_cli():

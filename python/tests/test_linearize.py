@@ -41,6 +41,7 @@ def test_linearize_a_scenario_from_text_and_from_a_dict():
     assert polhode.linearize(polhode.loads(text)) == from_file
 
 
-def test_linearize_wants_a_scenario():
-    with pytest.raises(TypeError):
-        polhode.linearize("scenarios/nutation-damper.yaml")
+def test_linearize_wants_a_scenario_or_a_path():
+    # A path is loaded (test_arguments.py); anything else is a TypeError.
+    with pytest.raises(TypeError, match=r"^linearize\(\): scenario must be"):
+        polhode.linearize(3.5)

@@ -1,4 +1,5 @@
-"""Result.telemetry against `polhode run --csv`, Result.to_pandas, and how the arrays are held."""
+"""Result.telemetry against `polhode run --csv`, Result.to_pandas and units, and how the arrays
+are held."""
 
 import csv
 import subprocess
@@ -54,16 +55,54 @@ def test_effector_columns_are_prefixed_by_the_effector_name():
     assert "damper.offset" in result.telemetry and "platform.rate" in result.telemetry
 
 
-def test_to_pandas_has_t_and_every_telemetry_column():
+def test_to_pandas_columns_are_the_cli_csv_header_and_its_values(polhode_cli, tmp_path):
+    """The DataFrame is the CLI's --csv table: the same header (units in it), the same numbers."""
     pd = pytest.importorskip("pandas")
+    out = tmp_path / "samples.csv"
+    subprocess.run(
+        [str(polhode_cli), "run", str(REPO / "scenarios/dual-spin-rotor-damper.yaml"),
+         "--no-log", "--quiet", "--csv", str(out), "--duration", "10"],
+        check=True,
+    )
+    with open(out, newline="") as f:
+        rows = list(csv.reader(f))
+    header = rows[0]
+    values = np.array([[float(v) for v in row] for row in rows[1:]])
+    assert "omega_x [rad/s]" in header and "damper.offset [m]" in header
+
     result = polhode.load(REPO / "scenarios/dual-spin-rotor-damper.yaml").run(duration=10.0)
     frame = result.to_pandas()
     assert isinstance(frame, pd.DataFrame)
-    assert list(frame.columns) == ["t"] + list(result.telemetry)
-    assert len(frame) == len(result.t)
-    assert np.array_equal(frame["t"].to_numpy(), result.t)
+    assert list(frame.columns) == header
+    assert len(frame) == len(values)
+    for k, name in enumerate(header):
+        assert np.array_equal(frame[name].to_numpy(), values[:, k]), name
+    # A copy: changing the frame leaves the result alone.
+    frame.iloc[0, 1] = 123.0
+    assert result.omega[0, 0] != 123.0
+
+
+def test_to_pandas_without_units_has_the_bare_names():
+    pytest.importorskip("pandas")
+    result = polhode.load(REPO / "scenarios/nutation-damper.yaml").run(duration=2.0)
+    frame = result.to_pandas(units=False)
+    assert list(frame.columns) == list(result.telemetry)
     for name, column in result.telemetry.items():
         assert np.array_equal(frame[name].to_numpy(), column), name
+    with pytest.raises(TypeError, match=r"^Result\.to_pandas\(\): units must be True or False"):
+        result.to_pandas(units="yes")
+
+
+def test_units_are_those_of_the_logs_doc():
+    result = polhode.load(REPO / "scenarios/dual-spin-rotor-damper.yaml").run(duration=1.0)
+    assert list(result.units) == list(result.telemetry)
+    # docs/logs.md's table.
+    assert result.units["sim_time"] == "s"
+    assert result.units["omega_x"] == "rad/s"
+    assert result.units["h_norm"] == "N m s"
+    assert result.units["kinetic_energy"] == "J"
+    assert result.units["damper.offset"] == "m"
+    assert result.units["platform.rate"] == "rad/s"
 
 
 def test_to_pandas_without_pandas_says_what_to_install(tmp_path):
@@ -79,7 +118,9 @@ def test_to_pandas_without_pandas_says_what_to_install(tmp_path):
         "    print(e)\n"
     )
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True)
-    assert "needs pandas" in out.stdout and "pip install pandas" in out.stdout
+    assert "Result.to_pandas() needs pandas" in out.stdout
+    assert "pip install pandas" in out.stdout
+    assert 'pip install "./python[all]"' in out.stdout
 
 
 def root_of(array):
