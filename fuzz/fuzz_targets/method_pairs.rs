@@ -1,6 +1,6 @@
 //! Fuzz target `method_pairs`: valid scenarios built from structured input (a triaxial body,
-//! optionally an orbit with environmental torques, wheels with each kind of motor, B-dot
-//! magnetorquers, a dissipation torque), each run briefly under dop853 and under a second
+//! optionally an orbit with environmental torques, eddy currents and hysteresis rods, wheels
+//! with each kind of motor, B-dot magnetorquers, a dissipation torque), each run briefly under dop853 and under a second
 //! method, which must agree with it within its own error or be refused cleanly
 //! (docs/reliability.md, "The method contract").
 //!
@@ -31,6 +31,8 @@ enum Environment {
     MagneticDipole([i8; 3]),
     SolarPressure { area: u8, normal: [i8; 3] },
     Aerodynamic,
+    EddyCurrents { radius: u8 },
+    HysteresisRod { axis: [i8; 3], length: u8 },
 }
 
 #[derive(Debug, Arbitrary)]
@@ -128,6 +130,23 @@ fn yaml(c: &Case) -> String {
                 }
                 Environment::Aerodynamic => {
                     format!("aerodynamic: {{name: a{k}, drag_coefficient: 2.2, from_shape: true}}")
+                }
+                Environment::EddyCurrents { radius } => format!(
+                    "eddy_currents: {{name: e{k}, conductivity: 3.5e7, \
+                     shape: {{spherical_shell: {{radius: {}, thickness: 0.002}}}}}}",
+                    0.05 + f64::from(*radius) / 1000.0
+                ),
+                Environment::HysteresisRod { axis: a, length } => {
+                    let a = axis(*a);
+                    format!(
+                        "hysteresis_rod: {{name: h{k}, axis: [{}, {}, {}], length: {}, \
+                         diameter: 0.001, coercivity: 1.59, remanence: 0.35, saturation: 0.73, \
+                         properties: material}}",
+                        a[0],
+                        a[1],
+                        a[2],
+                        0.02 + f64::from(*length) / 2000.0
+                    )
                 }
             });
         }
