@@ -14,7 +14,8 @@
 //!   1e-7 and 1e-9, the latter within twice the distance plus 1e-8; `exact` within 1e-8;
 //!   `averaged` in T within 5 ε_max = 0.05 of T's band and |H| within 0.05, or stopped with a
 //!   diagnosis. Errors are the hub's:
-//!   rates relative to the larger |ω| of start and end, and attitude (rad).
+//!   rates relative to the larger |ω| of start and end (at least 1e-4 rad/s), and attitude
+//!   (rad).
 
 #![no_main]
 
@@ -284,7 +285,11 @@ fuzz_target!(|c: Case| {
         return;
     }
     let end_rate = (0..3).map(|i| reference[i].powi(2)).sum::<f64>().sqrt();
-    let scale = base.omega0.norm().max(end_rate).max(1e-9);
+    // Below 1e-4 rad/s the rates are compared absolutely: an adaptive method's absolute
+    // tolerance (atol = 1e-3 rtol, 1e-12 rad/s at rtol 1e-9) bounds what it resolves there,
+    // and a body nearly at rest (a B-dot scene starting from ω = 0) reaches 1e-8 rad/s, where
+    // a 1e-14 rad/s difference would read as 1e-6 relative.
+    let scale = base.omega0.norm().max(end_rate).max(1e-4);
     let (first, second) = if fixed {
         (settings(Some(h), None), settings(Some(h / 2.0), None))
     } else if name == "exact" {
@@ -338,10 +343,12 @@ fuzz_target!(|c: Case| {
     let bound = if name == "exact" {
         1e-8
     } else {
-        let coarse = parse(&first)
-            .ok()
-            .and_then(|s| solve(&s).ok())
-            .unwrap_or_else(|| panic!("{name} ran at the finer setting only\n{text}"));
+        // The coarser setting may stop with a diagnosis where the finer one runs (a Newton
+        // iteration meeting a hysteresis rod's kink at the larger step): a clean failure, and
+        // without it there is no error estimate to compare with.
+        let Some(coarse) = parse(&first).ok().and_then(|s| solve(&s).ok()) else {
+            return;
+        };
         2.0 * hub_error(&coarse, &fine, scale) + 1e-8
     };
     assert!(
