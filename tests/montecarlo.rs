@@ -459,6 +459,77 @@ fn bad_campaign_definitions_are_located_errors() {
         "final_telemetry: [h_nrom]",
         &["unknown telemetry field `h_nrom`", "did you mean `h_norm`"],
     );
+    let pair = "paths: [\"initial.omega[0]\", \"initial.omega[1]\"]";
+    let last = "path: \"initial.omega[0]\", normal: {sd: 0.01}";
+    case(
+        "covariance-asymmetric",
+        last,
+        &format!("{pair}, normal: {{covariance: [[1.0e-4, 0.5e-4], [0.4e-4, 1.0e-4]]}}"),
+        &[
+            "montecarlo.dispersions[6].normal.covariance",
+            ":29:",
+            "symmetric",
+            "[0][1] is 0.00005",
+        ],
+    );
+    case(
+        "covariance-not-semidefinite",
+        last,
+        &format!("{pair}, normal: {{covariance: [[1.0e-4, 2.0e-4], [2.0e-4, 1.0e-4]]}}"),
+        &[
+            "montecarlo.dispersions[6].normal.covariance",
+            "positive semidefinite",
+            "eigenvalue -1.0",
+        ],
+    );
+    case(
+        "covariance-size",
+        last,
+        &format!("{pair}, normal: {{covariance: [[1.0e-4]]}}"),
+        &[
+            "expected 2 rows of 2 numbers",
+            "initial.omega[0], initial.omega[1]",
+        ],
+    );
+    case(
+        "sd-and-covariance",
+        last,
+        &format!("{pair}, normal: {{sd: 0.01, covariance: [[1.0, 0.0], [0.0, 1.0]]}}"),
+        &["montecarlo.dispersions[6]", "not both"],
+    );
+    case(
+        "paths-of-different-sizes",
+        last,
+        "paths: [initial.omega, duration], normal: {sd: 0.01}",
+        &["same size", "`initial.omega` has 3", "`duration` has 1"],
+    );
+    case(
+        "paths-truncated",
+        last,
+        &format!("{pair}, truncated_normal: {{sd: 0.01, min: 0.0}}"),
+        &["cannot share one draw"],
+    );
+    case(
+        "paths-unknown",
+        last,
+        "paths: [\"initial.omega[0]\", \"initial.omegga[1]\"], normal: {sd: 0.01}",
+        &["montecarlo.dispersions[6].paths[1]", "did you mean `omega`"],
+    );
+    case(
+        "physical-inertia-sd",
+        "{inertia: {sd: 0.01}}",
+        "{physical_inertia: {sd: [0.01, 0.02]}}",
+        &["montecarlo.dispersions[4]", "expected one number or 3"],
+    );
+    case(
+        "invalid-draws-policy",
+        "  probability_by:",
+        "  invalid_draws: sometimes\n  probability_by:",
+        &[
+            "montecarlo.invalid_draws",
+            "expected `redraw` or `exclude`, got `sometimes`",
+        ],
+    );
     // A whole-number field cannot be dispersed.
     let rods = root().join("scenarios/explorer1-pydy.yaml");
     let text = std::fs::read_to_string(&rods).unwrap();
@@ -524,7 +595,14 @@ fn invalid_draws_are_recorded_with_what_was_drawn() {
         .unwrap()
         .replace("log_normal: {sigma: 0.3}", "normal: {sd: 10.0}");
     let file = dir.join("invalid.yaml");
-    std::fs::write(&file, text).unwrap();
+    std::fs::write(
+        &file,
+        text.replace(
+            "  probability_by:",
+            "  invalid_draws: exclude\n  probability_by:",
+        ),
+    )
+    .unwrap();
     let out = dir.join("out");
     campaign(&[file.to_str().unwrap(), "--runs", "30"], &out);
     let summary = json(&out.join("summary.json"));
@@ -560,6 +638,81 @@ fn invalid_draws_are_recorded_with_what_was_drawn() {
         seen += 1;
     }
     assert_eq!(seen, invalid);
+    assert_eq!(summary["invalid_draws"]["policy"], "exclude");
+    assert_eq!(summary["invalid_draws"]["invalid_runs"], invalid);
+    let text = std::fs::read_to_string(out.join("summary.txt")).unwrap();
+    assert!(text.contains("invalid draws (exclude)"), "{text}");
+    assert!(
+        text.contains(&format!("with the {invalid} excluded runs")),
+        "{text}"
+    );
+
+    // The same campaign redrawing: the runs whose first draw was valid are the same runs,
+    // and each invalid one is drawn again from its own stream. So the redrawn campaign's
+    // probabilities lie within the range `exclude` gives for each (the excluded runs
+    // counted as without and with the event).
+    std::fs::write(&file, text_with_redraw(&dir)).unwrap();
+    let again = dir.join("redraw");
+    campaign(&[file.to_str().unwrap(), "--runs", "30"], &again);
+    let redrawn = json(&again.join("summary.json"));
+    assert_eq!(redrawn["status"]["invalid"], 0);
+    assert_eq!(redrawn["invalid_draws"]["policy"], "redraw");
+    let columns: Vec<String> = json(&again.join("campaign.json"))["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap().to_string())
+        .collect();
+    let rows = polhode::montecarlo::table::from_csv(
+        &std::fs::read_to_string(again.join("runs.csv")).unwrap(),
+        &columns,
+    )
+    .unwrap();
+    let r = columns.iter().position(|c| c == "redraws").unwrap();
+    let counts: Vec<f64> = rows.iter().map(|row| row.values[r].unwrap()).collect();
+    let count = &redrawn["invalid_draws"]["redrawn"][0];
+    assert_eq!(count["column"], "redraws");
+    assert_eq!(
+        count["rejected"].as_f64().unwrap(),
+        counts.iter().sum::<f64>()
+    );
+    assert_eq!(
+        count["runs"].as_u64().unwrap(),
+        invalid,
+        "the runs redrawn are the runs `exclude` left out"
+    );
+    let mut compared = 0;
+    for (e, f) in summary["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(redrawn["events"].as_array().unwrap())
+    {
+        for (b, c) in e["by"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(f["by"].as_array().unwrap())
+        {
+            let (lo, hi) = (
+                b["with_excluded"][0].as_f64().unwrap(),
+                b["with_excluded"][1].as_f64().unwrap(),
+            );
+            let p = c["probability"].as_f64().unwrap();
+            assert!(lo <= p && p <= hi, "{p} outside [{lo}, {hi}]");
+            assert!(hi - lo > 0.0);
+            compared += 1;
+        }
+    }
+    assert!(compared >= 6);
+}
+
+/// The invalid-draw scenario of [`invalid_draws_are_recorded_with_what_was_drawn`] under
+/// the default `invalid_draws` (redraw).
+fn text_with_redraw(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("invalid.yaml"))
+        .unwrap()
+        .replace("  invalid_draws: exclude\n", "")
 }
 
 #[test]
@@ -580,7 +733,8 @@ fn parquet_table_matches_the_csv_in_an_independent_reader() {
         .unwrap();
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{text}{}", stderr(&o));
-    assert!(text.contains("rows 25 columns 32 identical"), "{text}");
+    // 32 columns, and `redraws` (the default `invalid_draws: redraw`).
+    assert!(text.contains("rows 25 columns 33 identical"), "{text}");
 }
 
 #[test]

@@ -5,6 +5,8 @@
 //! scenario file, so every numeric field can be perturbed and every perturbed scenario is
 //! validated exactly as a hand-written one would be.
 
+use super::covariance;
+use super::second_moments::SecondMoments;
 use nalgebra::{Matrix3, SymmetricEigen, UnitQuaternion, Vector3};
 use rand::{Rng, RngExt};
 use rand_distr::{Distribution as _, StandardNormal};
@@ -16,7 +18,8 @@ pub const MAX_INERTIA_REDRAWS: u32 = 1000;
 /// One perturbation.
 #[derive(Debug, Clone)]
 pub struct Dispersion {
-    /// The path as written, or `attitude` / `inertia`.
+    /// The path as written (the paths joined by `, `), or `attitude` / `inertia` /
+    /// `physical_inertia`.
     pub label: String,
     /// Where it acts.
     pub target: Target,
@@ -31,6 +34,9 @@ pub struct Dispersion {
 pub enum Target {
     /// A numeric field or list of numbers.
     Path(PathTarget),
+    /// Several fields drawn together: one shared draw, or one draw from a covariance of all
+    /// their components (each with its path as written).
+    Paths(Vec<(String, PathTarget)>),
     /// `initial.attitude`.
     Attitude,
     /// `body.principal` / `body.inertia`.
@@ -113,12 +119,36 @@ pub enum Distribution {
         sd: f64,
     },
     /// Principal moments Iₖ(1 + sd zₖ), axes rotated by Exp(θ), θ ~ N(0, axes² I₃); draws
-    /// that are not positive or break a triangle inequality are redrawn and counted.
+    /// that are not positive or break a triangle inequality are redrawn and counted (with
+    /// `redraw`; otherwise the first such draw makes the run invalid).
     Inertia {
         /// Relative standard deviation of each moment.
         sd: f64,
         /// Standard deviation of each rotation-vector component (rad).
         axes: f64,
+        /// Redraw unphysical moments (the campaign's `invalid_draws: redraw`).
+        redraw: bool,
+    },
+    /// Principal moments drawn through the second moments of mass (physical by
+    /// construction; equal moments share one draw with `keep_symmetry`), axes rotated by
+    /// Exp(θ), θ ~ N(0, axes² I₃).
+    PhysicalInertia {
+        /// Relative standard deviation of each principal moment, in `body.principal` order.
+        sd: [f64; 3],
+        /// Standard deviation of each rotation-vector component (rad).
+        axes: f64,
+        /// Equal moments stay equal.
+        keep_symmetry: bool,
+    },
+    /// x = x₀ + mean + L z over all the components of the paths together (times |x₀| if
+    /// relative), z standard normal, L Lᵀ the covariance.
+    Correlated {
+        /// Lower-triangular factor of the covariance.
+        factor: Vec<Vec<f64>>,
+        /// Offset of the mean, per component.
+        mean: Vec<f64>,
+        /// `mean` and the covariance are in fractions of |x₀|.
+        relative: bool,
     },
 }
 
@@ -130,7 +160,27 @@ impl Dispersion {
                 (0..p.len).map(|j| format!("{}[{j}]", self.label)).collect()
             }
             Target::Path(_) => vec![self.label.clone()],
+            Target::Paths(list) => list
+                .iter()
+                .flat_map(|(label, p)| {
+                    if p.is_list {
+                        (0..p.len).map(|j| format!("{label}[{j}]")).collect()
+                    } else {
+                        vec![label.clone()]
+                    }
+                })
+                .collect(),
             Target::Attitude => vec!["attitude_rotation_deg".into()],
+            Target::Inertia
+                if matches!(self.distribution, Distribution::PhysicalInertia { .. }) =>
+            {
+                vec![
+                    "inertia_moment_1".into(),
+                    "inertia_moment_2".into(),
+                    "inertia_moment_3".into(),
+                    "inertia_axes_rotation_deg".into(),
+                ]
+            }
             Target::Inertia => vec![
                 "inertia_moment_1".into(),
                 "inertia_moment_2".into(),
@@ -138,6 +188,22 @@ impl Dispersion {
                 "inertia_axes_rotation_deg".into(),
                 "inertia_redraws".into(),
             ],
+        }
+    }
+
+    /// The position among [`Dispersion::columns`] of the column that counts this
+    /// dispersion's own redraws (`inertia_redraws`), if it has one.
+    pub fn redraw_column(&self) -> Option<usize> {
+        matches!(self.distribution, Distribution::Inertia { .. }).then_some(4)
+    }
+
+    /// The fields this dispersion writes, with their paths as written (none for `attitude`
+    /// and the inertia dispersions, whose targets are fixed).
+    pub fn path_targets(&self) -> Vec<(&str, &PathTarget)> {
+        match &self.target {
+            Target::Path(p) => vec![(self.label.as_str(), p)],
+            Target::Paths(list) => list.iter().map(|(l, p)| (l.as_str(), p)).collect(),
+            Target::Attitude | Target::Inertia => Vec::new(),
         }
     }
 
@@ -155,17 +221,46 @@ impl Dispersion {
                 let x0 = p.nominal(tree);
                 let x = draw(d, &x0, rng)?;
                 record.extend_from_slice(&x);
-                let value = if p.is_list {
-                    Value::Array(x.iter().map(|v| json!(v)).collect())
-                } else {
-                    json!(x[0])
+                write_path(tree, &self.label, p, &x)
+            }
+            (Target::Paths(list), d) => {
+                let x0: Vec<Vec<f64>> = list.iter().map(|(_, p)| p.nominal(tree)).collect();
+                let drawn: Vec<Vec<f64>> = match d {
+                    Distribution::Correlated {
+                        factor,
+                        mean,
+                        relative,
+                    } => {
+                        let z: Vec<f64> = (0..factor.len()).map(|_| gauss(rng)).collect();
+                        let y = covariance::correlate(factor, &z);
+                        let mut k = 0;
+                        x0.iter()
+                            .map(|x0| {
+                                x0.iter()
+                                    .map(|x| {
+                                        let scale = if *relative { x.abs() } else { 1.0 };
+                                        let v = x + scale * (mean[k] + y[k]);
+                                        k += 1;
+                                        v
+                                    })
+                                    .collect()
+                            })
+                            .collect()
+                    }
+                    _ => {
+                        // One draw shared by every path: the same variates, each path about
+                        // its own nominal value.
+                        let u = variates(d, list[0].1.len, rng)?;
+                        x0.iter()
+                            .map(|x0| transform(d, x0, &u))
+                            .collect::<Result<_, _>>()?
+                    }
                 };
-                if x.iter().any(|v| !v.is_finite()) {
-                    return Err(format!("`{}`: the draw is not finite", self.label));
+                for x in &drawn {
+                    record.extend_from_slice(x);
                 }
-                match tree.pointer_mut(&p.pointer) {
-                    Some(slot) => *slot = value,
-                    None => return Err(format!("`{}` is missing from the scenario", self.label)),
+                for ((label, p), x) in list.iter().zip(&drawn) {
+                    write_path(tree, label, p, x)?;
                 }
                 Ok(())
             }
@@ -185,13 +280,21 @@ impl Dispersion {
                 );
                 Ok(())
             }
-            (Target::Inertia, Distribution::Inertia { sd, axes }) => {
-                let (moments, frame) = principal(tree)?;
+            (Target::Inertia, Distribution::Inertia { sd, axes, redraw }) => {
+                let (moments, frame, _) = principal(tree)?;
                 let mut redraws = 0u32;
                 let drawn = loop {
                     let m = Vector3::from_fn(|k, _| moments[k] * (1.0 + sd * gauss(rng)));
                     if physical(&m) {
                         break m;
+                    }
+                    if !redraw {
+                        record.extend_from_slice(&[m[0], m[1], m[2]]);
+                        return Err(format!(
+                            "inertia: the drawn moments [{}, {}, {}] are not a physical body \
+                             (a moment is not positive or exceeds the sum of the other two)",
+                            m[0], m[1], m[2]
+                        ));
                     }
                     redraws += 1;
                     if redraws >= MAX_INERTIA_REDRAWS {
@@ -202,10 +305,6 @@ impl Dispersion {
                     }
                 };
                 let theta = Vector3::from_fn(|_, _| axes * gauss(rng));
-                let rotation = UnitQuaternion::from_scaled_axis(theta).to_rotation_matrix();
-                let r = rotation.matrix() * frame;
-                let j = r * Matrix3::from_diagonal(&drawn) * r.transpose();
-                let j = 0.5 * (j + j.transpose());
                 record.extend_from_slice(&[
                     drawn[0],
                     drawn[1],
@@ -213,21 +312,32 @@ impl Dispersion {
                     theta.norm().to_degrees(),
                     f64::from(redraws),
                 ]);
-                let body = tree
-                    .as_object_mut()
-                    .and_then(|m| m.get_mut("body"))
-                    .and_then(|v| v.as_object_mut())
-                    .ok_or("the scenario has no `body` mapping")?;
-                body.remove("principal");
-                body.insert(
-                    "inertia".into(),
-                    json!([
-                        [j[(0, 0)], j[(0, 1)], j[(0, 2)]],
-                        [j[(1, 0)], j[(1, 1)], j[(1, 2)]],
-                        [j[(2, 0)], j[(2, 1)], j[(2, 2)]]
-                    ]),
-                );
-                Ok(())
+                write_inertia(tree, &drawn, &frame, &theta, false)
+            }
+            (
+                Target::Inertia,
+                Distribution::PhysicalInertia {
+                    sd,
+                    axes,
+                    keep_symmetry,
+                },
+            ) => {
+                let (moments, frame, principal_given) = principal(tree)?;
+                let z = [gauss(rng), gauss(rng), gauss(rng)];
+                let theta = Vector3::from_fn(|_, _| axes * gauss(rng));
+                let draw = SecondMoments::new(moments.into(), *sd, *keep_symmetry)
+                    .map_err(|e| format!("physical_inertia: {e}"))?;
+                let drawn = Vector3::from(draw.draw(&z));
+                record.extend_from_slice(&[
+                    drawn[0],
+                    drawn[1],
+                    drawn[2],
+                    theta.norm().to_degrees(),
+                ]);
+                // Without a rotation, moments written as `body.principal` stay principal
+                // moments exactly (models that need principal axes accept them).
+                let keep_principal = principal_given && *axes == 0.0;
+                write_inertia(tree, &drawn, &frame, &theta, keep_principal)
             }
             _ => Err(format!(
                 "`{}`: target and distribution do not match",
@@ -235,6 +345,63 @@ impl Dispersion {
             )),
         }
     }
+}
+
+/// Writes the drawn components `x` of the field `p` (written `label`) into `tree`.
+fn write_path(tree: &mut Value, label: &str, p: &PathTarget, x: &[f64]) -> Result<(), String> {
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(format!("`{label}`: the draw is not finite"));
+    }
+    let value = if p.is_list {
+        Value::Array(x.iter().map(|v| json!(v)).collect())
+    } else {
+        json!(x[0])
+    };
+    match tree.pointer_mut(&p.pointer) {
+        Some(slot) => {
+            *slot = value;
+            Ok(())
+        }
+        None => Err(format!("`{label}` is missing from the scenario")),
+    }
+}
+
+/// Writes the hub's principal moments `moments` (kg m²) with axes `frame` (columns) turned by
+/// Exp(`theta`): as `body.principal` when `as_principal` (the frame is then the identity and
+/// `theta` zero), else as the tensor `body.inertia`.
+fn write_inertia(
+    tree: &mut Value,
+    moments: &Vector3<f64>,
+    frame: &Matrix3<f64>,
+    theta: &Vector3<f64>,
+    as_principal: bool,
+) -> Result<(), String> {
+    let body = tree
+        .as_object_mut()
+        .and_then(|m| m.get_mut("body"))
+        .and_then(|v| v.as_object_mut())
+        .ok_or("the scenario has no `body` mapping")?;
+    if as_principal {
+        body.insert(
+            "principal".into(),
+            json!([moments[0], moments[1], moments[2]]),
+        );
+        return Ok(());
+    }
+    let rotation = UnitQuaternion::from_scaled_axis(*theta).to_rotation_matrix();
+    let r = rotation.matrix() * frame;
+    let j = r * Matrix3::from_diagonal(moments) * r.transpose();
+    let j = 0.5 * (j + j.transpose());
+    body.remove("principal");
+    body.insert(
+        "inertia".into(),
+        json!([
+            [j[(0, 0)], j[(0, 1)], j[(0, 2)]],
+            [j[(1, 0)], j[(1, 1)], j[(1, 2)]],
+            [j[(2, 0)], j[(2, 1)], j[(2, 2)]]
+        ]),
+    );
+    Ok(())
 }
 
 /// One standard normal draw.
@@ -250,28 +417,55 @@ fn physical(m: &Vector3<f64>) -> bool {
         && m[2] + m[0] >= m[1]
 }
 
-/// Draws the components of a path dispersion about the nominal `x0`.
-fn draw<R: Rng + ?Sized>(d: &Distribution, x0: &[f64], rng: &mut R) -> Result<Vec<f64>, String> {
+/// The `n` variates a shareable distribution draws (standard normals for `normal` and
+/// `log_normal`, uniforms on [0, 1) for `uniform`), one per component in order.
+fn variates<R: Rng + ?Sized>(d: &Distribution, n: usize, rng: &mut R) -> Result<Vec<f64>, String> {
+    match d {
+        Distribution::Normal { .. } | Distribution::LogNormal { .. } => {
+            Ok((0..n).map(|_| gauss(rng)).collect())
+        }
+        Distribution::UniformAbout { .. } | Distribution::UniformBetween { .. } => {
+            Ok((0..n).map(|_| rng.random::<f64>()).collect())
+        }
+        _ => Err("this distribution cannot share one draw between fields".into()),
+    }
+}
+
+/// The components drawn about the nominal `x0` from the variates `u` ([`variates`]).
+fn transform(d: &Distribution, x0: &[f64], u: &[f64]) -> Result<Vec<f64>, String> {
     let scale = |relative: bool, j: usize| if relative { x0[j].abs() } else { 1.0 };
+    let n = x0.len();
     Ok(match d {
-        Distribution::Normal { sd, mean, relative } => (0..x0.len())
-            .map(|j| x0[j] + scale(*relative, j) * (mean[j] + sd[j] * gauss(rng)))
+        Distribution::Normal { sd, mean, relative } => (0..n)
+            .map(|j| x0[j] + scale(*relative, j) * (mean[j] + sd[j] * u[j]))
             .collect(),
         Distribution::UniformAbout {
             half_width,
             relative,
-        } => (0..x0.len())
-            .map(|j| {
-                let u: f64 = rng.random();
-                x0[j] + scale(*relative, j) * half_width[j] * (2.0 * u - 1.0)
-            })
+        } => (0..n)
+            .map(|j| x0[j] + scale(*relative, j) * half_width[j] * (2.0 * u[j] - 1.0))
             .collect(),
-        Distribution::UniformBetween { lo, hi } => (0..x0.len())
-            .map(|j| {
-                let u: f64 = rng.random();
-                lo[j] + (hi[j] - lo[j]) * u
-            })
-            .collect(),
+        Distribution::UniformBetween { lo, hi } => {
+            (0..n).map(|j| lo[j] + (hi[j] - lo[j]) * u[j]).collect()
+        }
+        Distribution::LogNormal { sigma } => {
+            (0..n).map(|j| x0[j] * (sigma[j] * u[j]).exp()).collect()
+        }
+        _ => return Err("this distribution cannot share one draw between fields".into()),
+    })
+}
+
+/// Draws the components of a path dispersion about the nominal `x0`.
+fn draw<R: Rng + ?Sized>(d: &Distribution, x0: &[f64], rng: &mut R) -> Result<Vec<f64>, String> {
+    let scale = |relative: bool, j: usize| if relative { x0[j].abs() } else { 1.0 };
+    Ok(match d {
+        Distribution::Normal { .. }
+        | Distribution::UniformAbout { .. }
+        | Distribution::UniformBetween { .. }
+        | Distribution::LogNormal { .. } => {
+            let u = variates(d, x0.len(), rng)?;
+            transform(d, x0, &u)?
+        }
         Distribution::TruncatedNormal {
             sd,
             lo,
@@ -295,9 +489,6 @@ fn draw<R: Rng + ?Sized>(d: &Distribution, x0: &[f64], rng: &mut R) -> Result<Ve
             }
             x
         }
-        Distribution::LogNormal { sigma } => (0..x0.len())
-            .map(|j| x0[j] * (sigma[j] * gauss(rng)).exp())
-            .collect(),
         Distribution::Tilt { sd } => {
             let v = Vector3::new(x0[0], x0[1], x0[2]);
             let n = v.norm();
@@ -313,8 +504,23 @@ fn draw<R: Rng + ?Sized>(d: &Distribution, x0: &[f64], rng: &mut R) -> Result<Ve
             let w = UnitQuaternion::from_scaled_axis(theta) * v;
             vec![w[0], w[1], w[2]]
         }
-        Distribution::Rotation { .. } | Distribution::Inertia { .. } => {
-            return Err("this distribution needs `attitude` or `inertia`".into());
+        Distribution::Correlated {
+            factor,
+            mean,
+            relative,
+        } => {
+            let z: Vec<f64> = (0..factor.len()).map(|_| gauss(rng)).collect();
+            let y = covariance::correlate(factor, &z);
+            (0..x0.len())
+                .map(|j| x0[j] + scale(*relative, j) * (mean[j] + y[j]))
+                .collect()
+        }
+        Distribution::Rotation { .. }
+        | Distribution::Inertia { .. }
+        | Distribution::PhysicalInertia { .. } => {
+            return Err(
+                "this distribution needs `attitude`, `inertia` or `physical_inertia`".into(),
+            );
         }
     })
 }
@@ -333,8 +539,9 @@ fn attitude(tree: &Value) -> UnitQuaternion<f64> {
     }
 }
 
-/// Nominal principal moments and axes (columns) of the hub in `tree`.
-fn principal(tree: &Value) -> Result<(Vector3<f64>, Matrix3<f64>), String> {
+/// Nominal principal moments and axes (columns) of the hub in `tree`, and whether they were
+/// written as `body.principal` (the axes are then the body axes).
+fn principal(tree: &Value) -> Result<(Vector3<f64>, Matrix3<f64>, bool), String> {
     let numbers = |v: &Value| -> Option<Vec<f64>> {
         v.as_array()?
             .iter()
@@ -344,7 +551,7 @@ fn principal(tree: &Value) -> Result<(Vector3<f64>, Matrix3<f64>), String> {
     if let Some(p) = tree.pointer("/body/principal").and_then(numbers)
         && p.len() == 3
     {
-        return Ok((Vector3::new(p[0], p[1], p[2]), Matrix3::identity()));
+        return Ok((Vector3::new(p[0], p[1], p[2]), Matrix3::identity(), true));
     }
     if let Some(rows) = tree.pointer("/body/inertia").and_then(Value::as_array) {
         let mut m = Matrix3::zeros();
@@ -355,7 +562,7 @@ fn principal(tree: &Value) -> Result<(Vector3<f64>, Matrix3<f64>), String> {
             }
         }
         let eig = SymmetricEigen::new(0.5 * (m + m.transpose()));
-        return Ok((eig.eigenvalues, eig.eigenvectors));
+        return Ok((eig.eigenvalues, eig.eigenvectors, false));
     }
     Err("inertia: the scenario has neither `body.principal` nor `body.inertia`".into())
 }

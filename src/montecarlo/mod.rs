@@ -7,9 +7,11 @@
 //! the cores, a block of runs at a time, and the finished rows go to the writers in run order:
 //! a campaign's memory does not grow with its number of runs.
 
+mod covariance;
 mod dispersion;
 pub mod output;
 pub mod runs;
+mod second_moments;
 mod select;
 mod spec;
 mod summary;
@@ -17,7 +19,7 @@ pub mod table;
 
 pub use crate::scenario::campaign::CampaignFile;
 pub use dispersion::{Dispersion, Distribution, Target, erfc, normal_mass};
-pub use spec::{Campaign, MAX_RUNS};
+pub use spec::{Campaign, InvalidDraws, MAX_DRAWS_PER_RUN, MAX_RUNS};
 pub use summary::{percentile, wilson95};
 pub use table::{Row, RunStatus};
 
@@ -114,6 +116,10 @@ pub struct Prepared {
     max_nutation_column: usize,
     /// The method every run uses instead of the scenario's (`--method`), if any.
     pub method: Option<String>,
+    /// Column counting the draws a run rejected (`redraws`), under `invalid_draws: redraw`.
+    run_redraw_column: Option<usize>,
+    /// Columns counting a dispersion's own redraws (`inertia_redraws`).
+    redraw_columns: Vec<usize>,
 }
 
 /// Hex SHA-256 of `bytes`.
@@ -251,7 +257,7 @@ impl Prepared {
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         for (k, d) in campaign.dispersions.iter().enumerate() {
             let field = format!("montecarlo.dispersions[{k}]");
-            if let Target::Path(p) = &d.target {
+            for (label, p) in d.path_targets() {
                 if p.pointer.starts_with("/events/") || p.pointer.starts_with("/stop/") {
                     return Err(ScenarioError::at(
                         &path,
@@ -272,10 +278,9 @@ impl Prepared {
                         d.at,
                         format!("{field}.path"),
                         format!(
-                            "`{}` is no longer there when this dispersion applies: an \
+                            "`{label}` is no longer there when this dispersion applies: an \
                              earlier one replaced it (`inertia` turns `body.principal` into \
-                             `body.inertia`); list this dispersion before that one",
-                            d.label
+                             `body.inertia`); list this dispersion before that one"
                         ),
                     ));
                 }
@@ -287,7 +292,7 @@ impl Prepared {
         // Each perturbed field must take a continuous value: the nominal value written as a
         // floating-point number (4 → 4.0) must still load; a count or a stage number fails.
         for (k, d) in campaign.dispersions.iter().enumerate() {
-            if let Target::Path(p) = &d.target {
+            for (label, p) in d.path_targets() {
                 let mut probe = tree.clone();
                 let x0 = p.nominal(&probe);
                 let as_float: Vec<Value> = x0.iter().map(|x| serde_json::json!(x)).collect();
@@ -305,9 +310,9 @@ impl Prepared {
                         d.at,
                         format!("montecarlo.dispersions[{k}].path"),
                         format!(
-                            "`{}` does not take a continuous value ({}), so it \
+                            "`{label}` does not take a continuous value ({}), so it \
                              cannot be dispersed",
-                            d.label, e.message
+                            e.message
                         ),
                     ));
                 }
@@ -316,8 +321,12 @@ impl Prepared {
         // A field perturbed twice (a tilt, then a magnitude) records the value after each;
         // the later columns are told apart by `@k`, k the dispersion's index.
         let mut columns: Vec<String> = Vec::new();
+        let mut redraw_columns = Vec::new();
         for (k, d) in campaign.dispersions.iter().enumerate() {
-            for c in d.columns() {
+            for (m, c) in d.columns().into_iter().enumerate() {
+                if d.redraw_column() == Some(m) {
+                    redraw_columns.push(columns.len());
+                }
                 if columns.contains(&c) {
                     columns.push(format!("{c}@{k}"));
                 } else {
@@ -325,6 +334,11 @@ impl Prepared {
                 }
             }
         }
+        // Under `invalid_draws: redraw`, the draws each run rejected before its valid one.
+        let run_redraw_column = (campaign.invalid_draws == InvalidDraws::Redraw).then(|| {
+            columns.push("redraws".into());
+            columns.len() - 1
+        });
         let transverse_column = columns.len();
         columns.push("initial_transverse_rate".into());
         let event_start = columns.len();
@@ -384,6 +398,8 @@ impl Prepared {
             event_start,
             max_nutation_column,
             method: None,
+            run_redraw_column,
+            redraw_columns,
         })
     }
 
@@ -410,14 +426,50 @@ impl Prepared {
         Ok(self)
     }
 
-    /// The perturbed scenario of run `i` and the recorded inputs.
+    /// The perturbed scenario of run `i` and the recorded inputs (the dispersions' columns,
+    /// then under `invalid_draws: redraw` the number of draws rejected). Under `redraw`, a
+    /// draw that is not a valid scenario is followed by the next draw of the run's own
+    /// stream, up to [`MAX_DRAWS_PER_RUN`] draws: the result still depends on (seed, i)
+    /// alone.
     pub fn build_run(&self, i: u64) -> Result<(Scenario, Vec<f64>), InvalidDraw> {
         let mut rng = self.stream(i);
+        let redraw = self.campaign.invalid_draws == InvalidDraws::Redraw;
+        let mut rejected = 0u32;
+        loop {
+            match self.draw_once(&mut rng) {
+                Ok((sc, mut inputs)) => {
+                    if redraw {
+                        inputs.push(f64::from(rejected));
+                    }
+                    return Ok((sc, inputs));
+                }
+                Err(_) if redraw && rejected + 1 < MAX_DRAWS_PER_RUN => rejected += 1,
+                Err(mut e) => {
+                    if redraw {
+                        e.message = format!(
+                            "no valid draw in {MAX_DRAWS_PER_RUN} (invalid_draws: redraw); the \
+                             last: {}",
+                            e.message
+                        );
+                        e.redraws = Some(rejected + 1);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+    }
+
+    /// One draw of every dispersion from `rng`, and the scenario it gives.
+    fn draw_once(&self, rng: &mut ChaCha8Rng) -> Result<(Scenario, Vec<f64>), InvalidDraw> {
         let mut tree = self.tree.clone();
         let mut inputs = Vec::new();
         for d in &self.campaign.dispersions {
-            if let Err(message) = d.apply(&mut tree, &mut rng, &mut inputs) {
-                return Err(InvalidDraw { message, inputs });
+            if let Err(message) = d.apply(&mut tree, rng, &mut inputs) {
+                return Err(InvalidDraw {
+                    message,
+                    inputs,
+                    redraws: None,
+                });
             }
         }
         let parsed = serde_json::to_string(&tree)
@@ -435,7 +487,11 @@ impl Prepared {
                 sc.path = self.scenario_file.clone().into();
                 Ok((sc, inputs))
             }
-            Err(message) => Err(InvalidDraw { message, inputs }),
+            Err(message) => Err(InvalidDraw {
+                message,
+                inputs,
+                redraws: None,
+            }),
         }
     }
 
@@ -449,10 +505,17 @@ impl Prepared {
         let mut values = vec![None; self.columns.len()];
         let (sc, inputs) = match built {
             Ok(x) => x,
-            Err(InvalidDraw { message, inputs }) => {
+            Err(InvalidDraw {
+                message,
+                inputs,
+                redraws,
+            }) => {
                 // Keep what was drawn, so the table shows which draw was invalid.
                 for (k, v) in inputs.iter().enumerate() {
                     values[k] = Some(*v);
+                }
+                if let (Some(j), Some(n)) = (self.run_redraw_column, redraws) {
+                    values[j] = Some(f64::from(n));
                 }
                 return Some(Row {
                     run: i,
@@ -690,6 +753,11 @@ impl Prepared {
                 .collect(),
             probability_by: self.campaign.probability_by.clone(),
             rank: self.rank_rule(),
+            invalid_draws: summary::InvalidDrawSpec {
+                policy: self.campaign.invalid_draws.label(),
+                run_column: self.run_redraw_column,
+                dispersion_columns: self.redraw_columns.clone(),
+            },
         }
     }
 
@@ -720,6 +788,8 @@ pub struct InvalidDraw {
     pub message: String,
     /// The recorded inputs drawn before the failure.
     pub inputs: Vec<f64>,
+    /// Under `invalid_draws: redraw`, the draws made in vain (the run then has no valid one).
+    pub redraws: Option<u32>,
 }
 
 impl std::fmt::Display for InvalidDraw {

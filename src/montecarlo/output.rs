@@ -139,6 +139,7 @@ struct SummaryDoc {
     runs_in_table: u64,
     partial: bool,
     status: StatusCounts,
+    invalid_draws: summary::InvalidDrawStats,
     percentiles: &'static [f64],
     events: Vec<EventStats>,
     charts: Vec<EventCharts>,
@@ -411,6 +412,7 @@ fn summary_doc(m: &Manifest, stats: summary::Statistics, charts: Vec<EventCharts
         runs_in_table: m.runs_in_table,
         partial: m.partial,
         status: stats.status,
+        invalid_draws: stats.invalid_draws,
         percentiles: &summary::PERCENTILES,
         events: stats.events,
         charts,
@@ -450,6 +452,22 @@ fn summary_text(d: &SummaryDoc) -> String {
         "runs: {} complete, {} stopped, {} failed, {} invalid, {} invalid_model",
         s.complete, s.stopped, s.failed, s.invalid, s.invalid_model
     );
+    let v = &d.invalid_draws;
+    let _ = writeln!(
+        out,
+        "invalid draws ({}): {}; {} run(s) left invalid",
+        v.policy, v.meaning, v.invalid_runs
+    );
+    for r in &v.redrawn {
+        let _ = writeln!(
+            out,
+            "  {}: {} draw(s) rejected and drawn again, in {} run(s) (rejection rate {})",
+            r.column,
+            r.rejected,
+            r.runs,
+            f(r.rejection_rate)
+        );
+    }
     for e in &d.events {
         let excluded = if e.excluded == 0 {
             String::new()
@@ -476,6 +494,18 @@ fn summary_text(d: &SummaryDoc) -> String {
                 f(b.ci95[1]),
                 b.count
             );
+            if e.excluded > 0 {
+                let _ = writeln!(
+                    out,
+                    "    with the {} excluded runs as not having had it / as having had it: \
+                     {} to {} (95% CI {} to {})",
+                    e.excluded,
+                    f(b.with_excluded[0]),
+                    f(b.with_excluded[1]),
+                    f(b.ci95_with_excluded[0]),
+                    f(b.ci95_with_excluded[1])
+                );
+            }
         }
     }
     if !d.charts.is_empty() {

@@ -1,6 +1,7 @@
 //! The `montecarlo:` block as written in YAML, and its validation into a [`Campaign`]
 //! (documented in `docs/montecarlo.md`).
 
+use super::covariance;
 use super::dispersion::{Dispersion, Distribution, PathTarget, Target, resolve_path};
 use crate::log::telemetry::FIELDS;
 use crate::scenario::campaign::{AngleFile, CampaignFile, DispersionFile, OneOrMany};
@@ -26,7 +27,34 @@ pub struct Campaign {
     pub probability_by: Vec<f64>,
     /// Indices into [`FIELDS`] recorded at the end.
     pub final_telemetry: Vec<usize>,
+    /// What is done with a draw that is not a valid scenario.
+    pub invalid_draws: InvalidDraws,
 }
+
+/// What a campaign does with a draw that is not a valid scenario (`invalid_draws:`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InvalidDraws {
+    /// Draw the run again from its own stream, up to [`MAX_DRAWS_PER_RUN`] times, and count
+    /// the rejected draws (the `redraws` column).
+    Redraw,
+    /// Record the run as `invalid` and leave it out of the probabilities, each given with its
+    /// range if every excluded run had or had not the event.
+    Exclude,
+}
+
+impl InvalidDraws {
+    /// The name written in the scenario and the summaries.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Redraw => "redraw",
+            Self::Exclude => "exclude",
+        }
+    }
+}
+
+/// Most draws of one run under `invalid_draws: redraw`; a run with no valid draw among them
+/// is recorded `invalid`.
+pub const MAX_DRAWS_PER_RUN: u32 = 1000;
 
 impl Campaign {
     /// Checks `file` against the scenario's YAML tree `tree` (paths must name numbers).
@@ -45,10 +73,28 @@ impl Campaign {
                 format!("expected a number of runs from 1 to {MAX_RUNS}, got {runs}"),
             ));
         }
+        let invalid_draws = match &file.invalid_draws {
+            None => InvalidDraws::Redraw,
+            Some(p) => match p.value.trim() {
+                "redraw" => InvalidDraws::Redraw,
+                "exclude" => InvalidDraws::Exclude,
+                other => {
+                    return Err(err(
+                        loc(p),
+                        "montecarlo.invalid_draws",
+                        format!("expected `redraw` or `exclude`, got `{other}`"),
+                    ));
+                }
+            },
+        };
         let mut dispersions = Vec::new();
         for (k, d) in file.dispersions.iter().enumerate() {
             let field = format!("montecarlo.dispersions[{k}]");
-            dispersions.push(dispersion(path, &field, d, tree)?);
+            let mut d = dispersion(path, &field, d, tree)?;
+            if let Distribution::Inertia { redraw, .. } = &mut d.distribution {
+                *redraw = invalid_draws == InvalidDraws::Redraw;
+            }
+            dispersions.push(d);
         }
         let mut probability_by = Vec::new();
         for (k, t) in file.probability_by.iter().enumerate() {
@@ -90,6 +136,7 @@ impl Campaign {
             dispersions,
             probability_by,
             final_telemetry,
+            invalid_draws,
         })
     }
 }
@@ -111,6 +158,7 @@ fn dispersion(
         ("tilt", f.tilt.is_some()),
         ("attitude", f.attitude.is_some()),
         ("inertia", f.inertia.is_some()),
+        ("physical_inertia", f.physical_inertia.is_some()),
     ]
     .into_iter()
     .filter_map(|(n, g)| g.then_some(n))
@@ -118,7 +166,7 @@ fn dispersion(
     if given.len() != 1 {
         return Err(err(format!(
             "expected exactly one of `normal`, `uniform`, `truncated_normal`, `log_normal`, \
-             `tilt` (each with `path`), `attitude` or `inertia`; got {}",
+             `tilt` (each with `path`), `attitude`, `inertia` or `physical_inertia`; got {}",
             if given.is_empty() {
                 "none".to_string()
             } else {
@@ -137,6 +185,14 @@ fn dispersion(
             )))
         }
     };
+    if f.paths.is_some()
+        && (f.attitude.is_some() || f.inertia.is_some() || f.physical_inertia.is_some())
+    {
+        return Err(err(format!(
+            "`{}` acts on a fixed field; remove `paths`",
+            given[0]
+        )));
+    }
     if let Some(a) = &f.attitude {
         if f.path.is_some() {
             return Err(err(
@@ -176,19 +232,171 @@ fn dispersion(
         return Ok(Dispersion {
             label: "inertia".into(),
             target: Target::Inertia,
-            distribution: Distribution::Inertia { sd: i.sd, axes },
+            distribution: Distribution::Inertia {
+                sd: i.sd,
+                axes,
+                redraw: true,
+            },
             at,
         });
     }
-    let Some(p) = &f.path else {
-        return Err(err(format!(
-            "`{}` needs `path`: the field it perturbs",
-            given[0]
-        )));
+    if let Some(i) = &f.physical_inertia {
+        if f.path.is_some() {
+            return Err(err(
+                "`physical_inertia` acts on `body`; remove `path`".into()
+            ));
+        }
+        let principal_given = tree.pointer("/body/principal").is_some();
+        if !principal_given && tree.pointer("/body/inertia").is_none() {
+            return Err(err(
+                "`physical_inertia` needs `body.principal` or `body.inertia` in the scenario"
+                    .into(),
+            ));
+        }
+        let sd = match &i.sd {
+            OneOrMany::One(x) => [*x; 3],
+            OneOrMany::Many(v) if v.len() == 3 && principal_given => [v[0], v[1], v[2]],
+            OneOrMany::Many(v) if v.len() == 3 => {
+                return Err(err(
+                    "physical_inertia.sd: one sd per moment follows the order of \
+                     `body.principal`; with `body.inertia` give one number"
+                        .into(),
+                ));
+            }
+            OneOrMany::Many(v) => {
+                return Err(err(format!(
+                    "physical_inertia.sd: expected one number or 3 (one per principal moment), \
+                     got {}",
+                    v.len()
+                )));
+            }
+        };
+        if sd
+            .iter()
+            .any(|s| !(s.is_finite() && (0.0..=0.3).contains(s)))
+        {
+            return Err(err(format!(
+                "physical_inertia.sd: expected relative standard deviations from 0 to 0.3, got \
+                 {sd:?}"
+            )));
+        }
+        let keep_symmetry = match i.symmetry.as_deref().map(str::trim) {
+            None | Some("keep") => true,
+            Some("break") => false,
+            Some(other) => {
+                return Err(err(format!(
+                    "physical_inertia.symmetry: expected `keep` or `break`, got `{other}`"
+                )));
+            }
+        };
+        let axes = angle(
+            &AngleFile {
+                sd_deg: i.axes_sd_deg,
+            },
+            "physical_inertia.axes",
+        )?;
+        let distribution = Distribution::PhysicalInertia {
+            sd,
+            axes,
+            keep_symmetry,
+        };
+        let d = Dispersion {
+            label: "physical_inertia".into(),
+            target: Target::Inertia,
+            distribution,
+            at,
+        };
+        // The nominal body must be drawable (not flat, sds its shape allows).
+        let mut probe = tree.clone();
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(0);
+        d.apply(&mut probe, &mut rng, &mut Vec::new())
+            .map_err(err)?;
+        return Ok(d);
+    }
+    if f.path.is_some() && f.paths.is_some() {
+        return Err(err(
+            "give `path` (one field) or `paths` (several sharing the draw), not both".into(),
+        ));
+    }
+    // The fields: one `path`, or `paths` drawn together.
+    let (targets, label, at_path) = match (&f.path, &f.paths) {
+        (Some(p), _) => {
+            let target: PathTarget = resolve_path(&p.value, tree)
+                .map_err(|m| ScenarioError::at(path, loc(p), format!("{field}.path"), m))?;
+            (
+                vec![(p.value.trim().to_string(), target)],
+                p.value.trim().to_string(),
+                loc(p),
+            )
+        }
+        (None, Some(list)) => {
+            if list.value.is_empty() {
+                return Err(ScenarioError::at(
+                    path,
+                    loc(list),
+                    format!("{field}.paths"),
+                    "expected a list of dotted paths, got none",
+                ));
+            }
+            let mut targets: Vec<(String, PathTarget)> = Vec::new();
+            for (j, p) in list.value.iter().enumerate() {
+                let where_ = format!("{field}.paths[{j}]");
+                let target = resolve_path(&p.value, tree)
+                    .map_err(|m| ScenarioError::at(path, loc(p), where_.clone(), m))?;
+                if let Some((other, _)) = targets.iter().find(|(_, t)| t.pointer == target.pointer)
+                {
+                    return Err(ScenarioError::at(
+                        path,
+                        loc(p),
+                        where_,
+                        format!("`{}` names the same field as `{other}`", p.value.trim()),
+                    ));
+                }
+                targets.push((p.value.trim().to_string(), target));
+            }
+            let label = targets
+                .iter()
+                .map(|(l, _)| l.as_str())
+                .collect::<Vec<_>>()
+                .join(", ");
+            (targets, label, loc(list))
+        }
+        (None, None) => {
+            return Err(err(format!(
+                "`{}` needs `path` (the field it perturbs) or `paths` (several fields sharing \
+                 one draw)",
+                given[0]
+            )));
+        }
     };
-    let target: PathTarget = resolve_path(&p.value, tree)
-        .map_err(|m| ScenarioError::at(path, loc(p), format!("{field}.path"), m))?;
-    let n = target.len;
+    let grouped = f.paths.is_some();
+    let covariance_given = f.normal.as_ref().is_some_and(|g| g.covariance.is_some());
+    if grouped && !covariance_given {
+        let n0 = targets[0].1.len;
+        if let Some((l, t)) = targets.iter().find(|(_, t)| t.len != n0) {
+            return Err(err(format!(
+                "paths: one draw is shared by fields of the same size; `{}` has {n0} \
+                 component(s) and `{l}` has {}",
+                targets[0].0, t.len
+            )));
+        }
+        if f.truncated_normal.is_some() || f.tilt.is_some() {
+            return Err(err(format!(
+                "`{}` cannot share one draw between fields (it depends on each field's \
+                 nominal value); give each its own `path`",
+                given[0]
+            )));
+        }
+    }
+    let target = targets[0].1.clone();
+    let p_value = label.clone();
+    // Components per drawn value: one field's under a shared draw, all of them together
+    // under a covariance.
+    let n = if covariance_given {
+        targets.iter().map(|(_, t)| t.len).sum()
+    } else {
+        target.len
+    };
     let vector = |v: &OneOrMany, what: &str| -> Result<Vec<f64>, ScenarioError> {
         let values = match v {
             OneOrMany::One(x) => vec![*x; n],
@@ -196,7 +404,7 @@ fn dispersion(
             OneOrMany::Many(xs) => {
                 return Err(err(format!(
                     "{what}: expected one number or {n} (one per component of `{}`), got {}",
-                    p.value,
+                    p_value,
                     xs.len()
                 )));
             }
@@ -215,13 +423,51 @@ fn dispersion(
         }
     };
     let distribution = if let Some(g) = &f.normal {
-        Distribution::Normal {
-            sd: non_negative(vector(&g.sd, "normal.sd")?, "normal.sd")?,
-            mean: match &g.mean {
-                Some(m) => vector(m, "normal.mean")?,
-                None => vec![0.0; n],
+        let mean = match &g.mean {
+            Some(m) => vector(m, "normal.mean")?,
+            None => vec![0.0; n],
+        };
+        match (&g.sd, &g.covariance) {
+            (Some(sd), None) => Distribution::Normal {
+                sd: non_negative(vector(sd, "normal.sd")?, "normal.sd")?,
+                mean,
+                relative: g.relative,
             },
-            relative: g.relative,
+            (None, Some(c)) => {
+                let factor = covariance::factor(&c.value, n).map_err(|e| {
+                    ScenarioError::at(
+                        path,
+                        loc(c),
+                        format!("{field}.normal.covariance"),
+                        format!("{e} (the components, in order: {})", {
+                            let mut names = Vec::new();
+                            for (l, t) in &targets {
+                                if t.is_list {
+                                    names.extend((0..t.len).map(|j| format!("{l}[{j}]")));
+                                } else {
+                                    names.push(l.clone());
+                                }
+                            }
+                            names.join(", ")
+                        }),
+                    )
+                })?;
+                Distribution::Correlated {
+                    factor,
+                    mean,
+                    relative: g.relative,
+                }
+            }
+            (Some(_), Some(_)) => {
+                return Err(err(
+                    "normal: give `sd` (independent components, or one draw shared by \
+                     `paths`) or `covariance` (correlated components), not both"
+                        .into(),
+                ));
+            }
+            (None, None) => {
+                return Err(err("normal: expected `sd` or `covariance`".into()));
+            }
         }
     } else if let Some(u) = &f.uniform {
         match (&u.half_width, &u.min, &u.max) {
@@ -291,7 +537,7 @@ fn dispersion(
         if n != 3 {
             return Err(err(format!(
                 "tilt: expected a 3-vector field; `{}` has {n} component(s)",
-                p.value
+                p_value
             )));
         }
         Distribution::Tilt {
@@ -301,9 +547,13 @@ fn dispersion(
         return Err(err("expected a distribution".into()));
     };
     Ok(Dispersion {
-        label: p.value.trim().to_string(),
-        target: Target::Path(target),
+        label,
+        target: if grouped {
+            Target::Paths(targets)
+        } else {
+            Target::Path(target)
+        },
         distribution,
-        at: loc(p),
+        at: at_path,
     })
 }

@@ -42,6 +42,51 @@ pub struct ProbabilityBy {
     pub probability: f64,
     /// 95 % Wilson score interval of the probability.
     pub ci95: [f64; 2],
+    /// The probability over all the runs, the excluded ones (failed, invalid, invalid_model)
+    /// counted as not having had the event, and as having had it: the range the exclusion
+    /// leaves open (equal to `probability` twice when no run is excluded).
+    pub with_excluded: [f64; 2],
+    /// The 95 % interval over all the runs whatever the excluded ones did: the lower Wilson
+    /// bound of the first case of `with_excluded`, the upper of the second.
+    pub ci95_with_excluded: [f64; 2],
+}
+
+/// What the summary counts of the draws that were not valid scenarios.
+#[derive(Debug, Clone)]
+pub struct InvalidDrawSpec {
+    /// `redraw` or `exclude` (the campaign's `invalid_draws`).
+    pub policy: &'static str,
+    /// The column of the draws each run rejected (`redraws`), under `redraw`.
+    pub run_column: Option<usize>,
+    /// The columns of a dispersion's own redraws (`inertia_redraws`).
+    pub dispersion_columns: Vec<usize>,
+}
+
+/// Draws rejected and drawn again, as one column counts them.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RedrawCount {
+    /// The column (`redraws`: whole draws of a run; `inertia_redraws`: the moments alone).
+    pub column: String,
+    /// Draws rejected.
+    pub rejected: u64,
+    /// Runs with at least one rejected draw.
+    pub runs: usize,
+    /// Rejected draws over all draws made (rejected and accepted).
+    pub rejection_rate: f64,
+}
+
+/// How the campaign treated the draws that were not valid scenarios, and how many there were.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct InvalidDrawStats {
+    /// `redraw` or `exclude`.
+    pub policy: &'static str,
+    /// What the probabilities then mean.
+    pub meaning: String,
+    /// Runs recorded `invalid` and left out of the probabilities (under `redraw`, the runs
+    /// without a valid draw in the most draws allowed).
+    pub invalid_runs: usize,
+    /// Draws rejected and drawn again, per counting column.
+    pub redrawn: Vec<RedrawCount>,
 }
 
 /// One event's statistics.
@@ -143,6 +188,8 @@ pub struct SummarySpec {
     pub probability_by: Vec<f64>,
     /// How runs are ranked.
     pub rank: RankRule,
+    /// What the invalid draws' counts are read from.
+    pub invalid_draws: InvalidDrawSpec,
 }
 
 /// One column's counts in the first pass.
@@ -152,6 +199,14 @@ struct ColumnTally {
     min: u64,
     max: u64,
     sum: ExactSum,
+}
+
+/// One redraw column's counts in the first pass.
+#[derive(Debug, Clone, Default)]
+struct RedrawTally {
+    rejected: u64,
+    runs: usize,
+    accepted: usize,
 }
 
 /// One event's counts in the first pass.
@@ -173,6 +228,8 @@ pub struct Tally {
     failures: Vec<Failure>,
     events: Vec<EventTally>,
     columns: Vec<ColumnTally>,
+    /// Per redraw column: the run's (if any), then the dispersions'.
+    redraws: Vec<RedrawTally>,
     /// Worst and best (key, run) under the rank rule, and the number of usable runs ranked.
     worst: Option<(u64, u64)>,
     best: Option<(u64, u64)>,
@@ -196,6 +253,7 @@ impl Tally {
                 spec.events.len()
             ],
             columns: vec![column; spec.columns.len()],
+            redraws: vec![RedrawTally::default(); spec.invalid_draws.counting_columns().len()],
             spec,
             runs: 0,
             usable: 0,
@@ -215,6 +273,22 @@ impl Tally {
             RunStatus::Failed => self.status.failed += 1,
             RunStatus::Invalid => self.status.invalid += 1,
             RunStatus::InvalidModel => self.status.invalid_model += 1,
+        }
+        let invalid = r.status == RunStatus::Invalid;
+        let run_column = self.spec.invalid_draws.run_column;
+        for (j, t) in self
+            .spec
+            .invalid_draws
+            .counting_columns()
+            .into_iter()
+            .zip(&mut self.redraws)
+        {
+            if let Some(n) = r.values[j].filter(|x| x.is_finite() && *x >= 0.0) {
+                t.rejected += n as u64;
+                t.runs += usize::from(n > 0.0);
+                // A run left invalid under `redraw` accepted no draw.
+                t.accepted += usize::from(!(invalid && Some(j) == run_column));
+            }
         }
         if !r.status.ok() {
             if self.failures.len() < LISTED_FAILURES {
@@ -264,6 +338,17 @@ impl Tally {
     }
 }
 
+impl InvalidDrawSpec {
+    /// The columns counting rejected draws: the run's first, then the dispersions'.
+    fn counting_columns(&self) -> Vec<usize> {
+        self.run_column
+            .iter()
+            .chain(&self.dispersion_columns)
+            .copied()
+            .collect()
+    }
+}
+
 impl RankRule {
     /// A usable run's ranking key: ascending from the worst run.
     fn key(&self, values: &[Option<f64>]) -> u64 {
@@ -285,6 +370,8 @@ pub struct Statistics {
     pub columns: Vec<ColumnStats>,
     /// The first failed or invalid runs.
     pub failures: Vec<Failure>,
+    /// The invalid draws: how they were treated, how many.
+    pub invalid_draws: InvalidDrawStats,
 }
 
 /// Completes `tally` by passes over `runs` (the runs it counted, in the same order): the
@@ -404,6 +491,7 @@ pub fn statistics(tally: &Tally, runs: &dyn Runs) -> Result<Statistics, String> 
         })
         .collect();
     let usable = tally.usable;
+    let all = tally.runs;
     let events = spec
         .events
         .iter()
@@ -428,16 +516,56 @@ pub fn statistics(tally: &Tally, runs: &dyn Runs) -> Result<Statistics, String> 
                         f64::NAN
                     },
                     ci95: wilson95(k, usable),
+                    with_excluded: if all > 0 {
+                        [
+                            k as f64 / all as f64,
+                            (k + all - usable) as f64 / all as f64,
+                        ]
+                    } else {
+                        [f64::NAN; 2]
+                    },
+                    ci95_with_excluded: [wilson95(k, all)[0], wilson95(k + all - usable, all)[1]],
                 })
                 .collect(),
         })
         .collect();
+    let invalid_draws = InvalidDrawStats {
+        policy: spec.invalid_draws.policy,
+        meaning: if spec.invalid_draws.policy == "redraw" {
+            "a draw that is not a valid scenario is drawn again from the run's own stream: \
+             the probabilities are those of the dispersions restricted to valid scenarios"
+                .into()
+        } else {
+            "a draw that is not a valid scenario is recorded `invalid` and left out: each \
+             probability is over the usable runs, with its range if every excluded run had \
+             not or had the event (`with_excluded`)"
+                .into()
+        },
+        invalid_runs: tally.status.invalid,
+        redrawn: spec
+            .invalid_draws
+            .counting_columns()
+            .iter()
+            .zip(&tally.redraws)
+            .map(|(&j, t)| RedrawCount {
+                column: spec.columns[j].clone(),
+                rejected: t.rejected,
+                runs: t.runs,
+                rejection_rate: if t.rejected > 0 {
+                    t.rejected as f64 / (t.rejected as f64 + t.accepted as f64)
+                } else {
+                    0.0
+                },
+            })
+            .collect(),
+    };
     Ok(Statistics {
         status: tally.status.clone(),
         events,
         ranking,
         columns,
         failures: tally.failures.clone(),
+        invalid_draws,
     })
 }
 
@@ -535,6 +663,14 @@ pub fn stats_table(stats: &[ColumnStats]) -> String {
 mod tests {
     use super::*;
 
+    fn no_redraws() -> InvalidDrawSpec {
+        InvalidDrawSpec {
+            policy: "exclude",
+            run_column: None,
+            dispersion_columns: Vec::new(),
+        }
+    }
+
     #[test]
     fn percentile_matches_numpy_linear() {
         // numpy.percentile([1, 2, 3, 4], [0, 25, 50, 90, 100]) = 1, 1.75, 2.5, 3.7, 4.
@@ -585,6 +721,7 @@ mod tests {
             events: Vec::new(),
             probability_by: Vec::new(),
             rank: rule,
+            invalid_draws: no_redraws(),
         };
         let mut tally = Tally::new(spec);
         rows.iter().for_each(|r| tally.add(r));
@@ -626,6 +763,7 @@ mod tests {
                 smaller_is_worse: false,
                 missing: f64::NEG_INFINITY,
             },
+            invalid_draws: no_redraws(),
         };
         let mut tally = Tally::new(spec);
         rows.iter().for_each(|r| tally.add(r));

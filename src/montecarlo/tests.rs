@@ -354,3 +354,298 @@ fn the_runs_expected_longest_start_first_and_do_cost_the_most() {
         (0..many).collect::<Vec<_>>()
     );
 }
+
+/// A campaign over a body with principal moments `principal` (a YAML list) and the given
+/// `dispersions` (and campaign-level `extra` keys), as the loader prepares it.
+fn prepared_body(principal: &str, extra: &str, dispersions: &str) -> Result<Prepared, String> {
+    let yaml = format!(
+        "name: body\n\
+         body:\n  principal: {principal}\n  spin_axis: [0, 0, 1]\n\
+         effectors:\n  - energy_sink: {{name: sink, time_constant: 10.0}}\n\
+         initial:\n  omega: [0.05, 0.05, 2.0]\n\
+         duration: 1.0\n\
+         montecarlo:\n  runs: {N}\n  seed: 11\n{extra}  dispersions:\n{dispersions}"
+    );
+    let sc = scenario::parse(Path::new("body.yaml"), yaml, &Overrides::default())
+        .map_err(|e| e.to_string())?;
+    Prepared::new(sc, "body.yaml", None, None).map_err(|e| e.to_string())
+}
+
+/// Sample correlation of `a` and `b`.
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let (ma, sa) = mean_sd(a);
+    let (mb, sb) = mean_sd(b);
+    let n = a.len() as f64;
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - ma) * (y - mb))
+        .sum::<f64>()
+        / ((n - 1.0) * sa * sb)
+}
+
+/// Φ, the standard normal distribution function.
+fn phi(x: f64) -> f64 {
+    0.5 * erfc(-x / std::f64::consts::SQRT_2)
+}
+
+#[test]
+fn physical_inertia_keeps_explorer1s_symmetry_and_never_rejects() {
+    // Explorer 1's slender hull: transverse moments 4.90, axial 0.065 kg m², the transverse
+    // ones within 1 % and the axial one within 3 %.
+    let p = prepared_body(
+        "[4.90, 4.90, 0.065]",
+        "",
+        "    - {physical_inertia: {sd: [0.01, 0.01, 0.03]}}\n",
+    )
+    .unwrap();
+    let rows = inputs(&p, N);
+    let redraws = column(&p, &rows, "redraws");
+    assert!(redraws.iter().all(|r| *r == 0.0), "a draw was rejected");
+    let (i1, i2, i3) = (
+        column(&p, &rows, "inertia_moment_1"),
+        column(&p, &rows, "inertia_moment_2"),
+        column(&p, &rows, "inertia_moment_3"),
+    );
+    for ((a, b), c) in i1.iter().zip(&i2).zip(&i3) {
+        assert_eq!(
+            a.to_bits(),
+            b.to_bits(),
+            "the transverse pair split: {a} {b}"
+        );
+        assert!(*c > 0.0 && a + a >= *c, "{a} {b} {c}");
+    }
+    // The axial moment is twice the transverse second moment J = ∫x² dm, drawn log-normal
+    // with mean J: ln(I₃/0.065) is exactly N(−0.03²/2, 0.03²).
+    let logs: Vec<f64> = i3.iter().map(|x| (x / 0.065).ln()).collect();
+    assert_matches("ln I3", &logs, -0.00045, 0.03);
+    // The transverse moments: 1 % to first order (the second-order terms, ~1e-4 of the
+    // spread, are far inside the five standard errors).
+    assert_matches("I1", &i1, 4.90, 0.049);
+    // Independent of the axial moment, as asked.
+    let r = correlation(&i1, &i3);
+    assert!(r.abs() < 5.0 / (N as f64).sqrt(), "correlation {r}");
+    // The run is built with those moments, as principal moments.
+    let (sc, rec) = p.build_run(5).unwrap();
+    let mut drawn = [rec[0], rec[1], rec[2]];
+    drawn.sort_by(f64::total_cmp);
+    for (k, want) in drawn.iter().enumerate() {
+        assert_eq!(sc.spacecraft.hub.principal_moments[k], *want);
+    }
+}
+
+#[test]
+fn independent_moment_draws_reject_a_third_of_explorer1s_hull() {
+    // The anchor: moments drawn each on its own, Iₖ(1 + 0.01 zₖ), break I₁ − I₂ ≤ I₃ when
+    // 0.049|z₁ − z₂| > 0.065 (1 + 0.01 z₃); to the first order in 0.01,
+    // p = 2 Φ(−0.065 / (0.049 √2)) ≈ 0.348, so the redraws per run are geometric with mean
+    // p/(1 − p). The second-moment draw above rejects none.
+    let p = prepared_body("[4.90, 4.90, 0.065]", "", "    - {inertia: {sd: 0.01}}\n").unwrap();
+    let n = 5000;
+    let rows = inputs(&p, n);
+    let redraws = column(&p, &rows, "inertia_redraws");
+    let rejected: f64 = redraws.iter().sum();
+    let rate = rejected / (rejected + n as f64);
+    let expected = 2.0 * phi(-0.065 / (0.049 * 2f64.sqrt()));
+    let se = (expected * (1.0 - expected) / (rejected + n as f64)).sqrt();
+    assert!(
+        (rate - expected).abs() < 5.0 * se + 2e-3,
+        "rejection rate {rate} vs {expected}"
+    );
+}
+
+#[test]
+fn physical_inertia_gives_each_moment_its_spread_on_a_triaxial_body() {
+    // (No energy sink here: turned axes would leave the spin axis off a principal axis.)
+    let p = prepared(
+        "",
+        "",
+        "    - {physical_inertia: {sd: [0.01, 0.02, 0.03], axes_sd_deg: 1.0}}\n",
+    );
+    let rows = inputs(&p, N);
+    let moments: Vec<Vec<f64>> = (1..=3)
+        .map(|k| column(&p, &rows, &format!("inertia_moment_{k}")))
+        .collect();
+    for (k, (nominal, sd)) in [(2.0, 0.01), (2.1, 0.02), (1.0, 0.03)].iter().enumerate() {
+        let v: Vec<f64> = moments[k].iter().map(|x| x / nominal).collect();
+        assert_matches(&format!("moment {}", k + 1), &v, 1.0, *sd);
+    }
+    for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+        let r = correlation(&moments[a], &moments[b]);
+        assert!(r.abs() < 5.0 / (N as f64).sqrt(), "moments {a} {b}: {r}");
+    }
+    // Turned axes: the hub has the drawn moments as its principal moments.
+    let (sc, rec) = p.build_run(7).unwrap();
+    let mut drawn = [rec[0], rec[1], rec[2]];
+    drawn.sort_by(f64::total_cmp);
+    for (k, want) in drawn.iter().enumerate() {
+        let got = sc.spacecraft.hub.principal_moments[k];
+        assert!((got - want).abs() < 1e-12 * want, "{got} vs {want}");
+    }
+}
+
+#[test]
+fn physical_inertia_refuses_what_no_body_can_do() {
+    let err = |principal: &str, d: &str| match prepared_body(principal, "", d) {
+        Ok(_) => panic!("{principal} {d}: accepted"),
+        Err(e) => e,
+    };
+    // A flat plate has no extent across its plane: its moments cannot move apart.
+    let e = err("[1.0, 1.0, 2.0]", "    - {physical_inertia: {sd: 0.01}}\n");
+    assert!(e.contains("flat across principal axis 3"), "{e}");
+    assert!(e.contains("montecarlo.dispersions[0]"), "{e}");
+    // Equal moments move together.
+    let e = err(
+        "[4.90, 4.90, 0.065]",
+        "    - {physical_inertia: {sd: [0.01, 0.02, 0.03]}}\n",
+    );
+    assert!(e.contains("need the same sd"), "{e}");
+    // Explorer 1's transverse moments 1 % apart would need its radial spread to vary by
+    // about 100 %.
+    let e = err(
+        "[4.90, 4.90, 0.065]",
+        "    - {physical_inertia: {sd: [0.01, 0.01, 0.03], symmetry: break}}\n",
+    );
+    assert!(e.contains("cannot move that"), "{e}");
+    let e = err(
+        "[4.90, 4.90, 0.065]",
+        "    - {physical_inertia: {sd: 0.01, symmetry: sometimes}}\n",
+    );
+    assert!(e.contains("expected `keep` or `break`"), "{e}");
+}
+
+#[test]
+fn grouped_paths_share_one_draw() {
+    let p = prepared(
+        "",
+        "",
+        "    - {paths: [\"initial.omega[0]\", \"initial.omega[2]\"], normal: {sd: 0.01, relative: true}}\n\
+         \x20   - {paths: [\"body.principal[0]\", \"body.principal[1]\"], log_normal: {sigma: 0.02}}\n",
+    );
+    let rows = inputs(&p, N);
+    let (a, b) = (
+        column(&p, &rows, "initial.omega[0]"),
+        column(&p, &rows, "initial.omega[2]"),
+    );
+    for (x, y) in a.iter().zip(&b) {
+        let (u, v) = ((x - 0.05) / 0.05, (y - 2.0) / 2.0);
+        assert!((u - v).abs() < 1e-12, "{u} {v}");
+    }
+    assert_matches("shared relative normal", &b, 2.0, 0.02);
+    let (a, b) = (
+        column(&p, &rows, "body.principal[0]"),
+        column(&p, &rows, "body.principal[1]"),
+    );
+    for (x, y) in a.iter().zip(&b) {
+        assert!((x / 2.0 - y / 2.1).abs() < 1e-14, "{x} {y}");
+    }
+    let logs: Vec<f64> = a.iter().map(|x| (x / 2.0).ln()).collect();
+    assert_matches("shared log-normal", &logs, 0.0, 0.02);
+}
+
+#[test]
+fn correlated_draws_have_the_given_mean_and_covariance() {
+    // Covariance of three components (correlations 0.5, −0.3 and 0), and an offset mean.
+    let c = [
+        [1.0e-4, 0.5e-4, 0.0],
+        [0.5e-4, 1.0e-4, -0.6e-4],
+        [0.0, -0.6e-4, 4.0e-4],
+    ];
+    let p = prepared(
+        "",
+        "",
+        "    - {paths: [\"initial.omega[0]\", \"initial.omega[1]\", \"initial.omega[2]\"], \
+         normal: {mean: [0.01, 0.0, -0.02], covariance: [[1.0e-4, 0.5e-4, 0.0], \
+         [0.5e-4, 1.0e-4, -0.6e-4], [0.0, -0.6e-4, 4.0e-4]]}}\n",
+    );
+    let rows = inputs(&p, N);
+    let n = N as f64;
+    let x: Vec<Vec<f64>> = (0..3)
+        .map(|k| column(&p, &rows, &format!("initial.omega[{k}]")))
+        .collect();
+    let mean = [0.06, 0.05, 1.98];
+    let m: Vec<f64> = x.iter().map(|v| v.iter().sum::<f64>() / n).collect();
+    for k in 0..3 {
+        assert!(
+            (m[k] - mean[k]).abs() < 5.0 * (c[k][k] / n).sqrt(),
+            "mean {k}: {} vs {}",
+            m[k],
+            mean[k]
+        );
+    }
+    // A Gaussian's sample covariance has variance (CᵢᵢCⱼⱼ + Cᵢⱼ²)/n.
+    for i in 0..3 {
+        for j in 0..3 {
+            let s = x[i]
+                .iter()
+                .zip(&x[j])
+                .map(|(a, b)| (a - m[i]) * (b - m[j]))
+                .sum::<f64>()
+                / (n - 1.0);
+            let se = ((c[i][i] * c[j][j] + c[i][j] * c[i][j]) / n).sqrt();
+            assert!(
+                (s - c[i][j]).abs() < 5.0 * se,
+                "covariance [{i}][{j}]: {s} vs {}",
+                c[i][j]
+            );
+        }
+    }
+    // A singular covariance (correlation 1) is a shared draw.
+    let p = prepared(
+        "",
+        "",
+        "    - {path: initial.omega, normal: {covariance: [[1.0e-4, 1.0e-4, 0.0], \
+         [1.0e-4, 1.0e-4, 0.0], [0.0, 0.0, 0.0]]}}\n",
+    );
+    for r in inputs(&p, 100) {
+        assert!((r[0] - r[1]).abs() < 1e-15, "{r:?}");
+        assert_eq!(r[2], 2.0);
+    }
+}
+
+#[test]
+fn invalid_draws_are_redrawn_from_the_runs_own_stream_and_counted() {
+    // A time constant drawn from N(10, 10²) is not positive with probability p = Φ(−1):
+    // the rejected draws before a valid one are geometric, mean p/(1 − p) and variance
+    // p/(1 − p)², and the accepted values follow N(10, 10²) given > 0, of mean
+    // 10 + 10 φ(1)/Φ(1) and variance 100 (1 − φ(1)/Φ(1) (1 + φ(1)/Φ(1))).
+    let d = "    - {path: \"effectors[sink].time_constant\", normal: {sd: 10.0}}\n";
+    let p = prepared_body("[2.0, 2.1, 1.0]", "", d).unwrap();
+    let rows = inputs(&p, N);
+    let pr = phi(-1.0);
+    let (m, _) = mean_sd(&column(&p, &rows, "redraws"));
+    let (mean, sd) = (pr / (1.0 - pr), pr.sqrt() / (1.0 - pr));
+    assert!(
+        (m - mean).abs() < 5.0 * sd / (N as f64).sqrt(),
+        "mean redraws {m} vs {mean}"
+    );
+    let tau = column(&p, &rows, "effectors[sink].time_constant");
+    assert!(tau.iter().all(|t| *t > 0.0));
+    let density = (-0.5f64).exp() / (2.0 * std::f64::consts::PI).sqrt();
+    let ratio = density / phi(1.0);
+    assert_matches(
+        "accepted time constants",
+        &tau,
+        10.0 + 10.0 * ratio,
+        10.0 * (1.0 - ratio * (1.0 + ratio)).sqrt(),
+    );
+    // Reproducible: run i gives the same draws, whatever was built before it.
+    for i in [3u64, 0, 17] {
+        assert_eq!(p.build_run(i).unwrap().1, rows[i as usize]);
+    }
+    // `exclude`: the same first draws, the invalid ones recorded as such.
+    let q = prepared_body("[2.0, 2.1, 1.0]", "  invalid_draws: exclude\n", d).unwrap();
+    assert!(!q.columns.iter().any(|c| c == "redraws"));
+    for i in 0..200u64 {
+        let redrawn = rows[i as usize][1];
+        match q.build_run(i) {
+            Ok((_, r)) => {
+                assert_eq!(redrawn, 0.0);
+                assert_eq!(r[0], rows[i as usize][0]);
+            }
+            Err(e) => {
+                assert!(redrawn > 0.0, "run {i}");
+                assert!(e.message.contains("expected a positive"), "{}", e.message);
+            }
+        }
+    }
+}

@@ -22,6 +22,9 @@ pub struct CampaignFile {
     /// Telemetry fields (see `docs/logs.md`) recorded at the end of each run.
     #[serde(default)]
     pub final_telemetry: Vec<Spanned<String>>,
+    /// What to do with a draw that is not a valid scenario: `redraw` (default) or `exclude`.
+    #[serde(default)]
+    pub invalid_draws: Option<Spanned<String>>,
 }
 
 /// One entry of `dispersions:`: a `path` and one distribution, or `attitude`, or `inertia`.
@@ -31,6 +34,10 @@ pub struct DispersionFile {
     /// Dotted path of a numeric field or list (`initial.omega`, `effectors[antenna].damping`).
     #[serde(default)]
     pub path: Option<Spanned<String>>,
+    /// Several paths sharing one draw (`normal.sd`, `uniform`, `log_normal`) or drawn together
+    /// from one covariance (`normal.covariance`).
+    #[serde(default)]
+    pub paths: Option<Spanned<Vec<Spanned<String>>>>,
     /// Gaussian about the nominal value.
     #[serde(default)]
     pub normal: Option<NormalFile>,
@@ -52,6 +59,10 @@ pub struct DispersionFile {
     /// Principal moments and axes of the hub perturbed, kept physical (no `path`).
     #[serde(default)]
     pub inertia: Option<InertiaFile>,
+    /// Principal moments drawn through the body's second moments of mass, physical by
+    /// construction and keeping equal moments equal (no `path`).
+    #[serde(default)]
+    pub physical_inertia: Option<PhysicalInertiaFile>,
 }
 
 /// A number, or one number per component.
@@ -64,12 +75,17 @@ pub enum OneOrMany {
     Many(Vec<f64>),
 }
 
-/// `normal: {sd, mean, relative}`.
+/// `normal: {sd, mean, relative}` or `normal: {covariance, mean, relative}`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NormalFile {
     /// Standard deviation (field units, or a fraction of the nominal value if `relative`).
-    pub sd: OneOrMany,
+    #[serde(default)]
+    pub sd: Option<OneOrMany>,
+    /// Covariance matrix of all the components of `path`/`paths` together, instead of `sd`
+    /// (squared field units, or of fractions of the nominal values if `relative`).
+    #[serde(default)]
+    pub covariance: Option<Spanned<Vec<Vec<f64>>>>,
     /// Offset of the mean from the nominal value (default 0).
     #[serde(default)]
     pub mean: Option<OneOrMany>,
@@ -138,4 +154,20 @@ pub struct InertiaFile {
     /// Standard deviation of each component of the principal axes' rotation vector (degrees).
     #[serde(default)]
     pub axes_sd_deg: f64,
+}
+
+/// `physical_inertia: {sd, axes_sd_deg, symmetry}`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicalInertiaFile {
+    /// Relative standard deviation of each principal moment: one number, or one per moment in
+    /// the order of `body.principal`.
+    pub sd: OneOrMany,
+    /// Standard deviation of each component of the principal axes' rotation vector (degrees).
+    #[serde(default)]
+    pub axes_sd_deg: f64,
+    /// `keep` (default): equal principal moments share one draw and stay equal; `break`:
+    /// every moment is drawn on its own.
+    #[serde(default)]
+    pub symmetry: Option<String>,
 }
