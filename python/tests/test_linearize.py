@@ -44,3 +44,21 @@ def test_linearize_a_scenario_from_text_and_from_a_dict():
 def test_linearize_wants_a_scenario():
     with pytest.raises(TypeError):
         polhode.linearize("scenarios/nutation-damper.yaml")
+
+
+def test_an_energy_sink_estimate_outside_its_assumptions_is_flagged():
+    """The nutation damper as shipped (+9.5 % from the eigenvalue) has a valid estimate; with
+    a spring fifty times softer it is thousands of percent off and flagged, with the reason."""
+    text = (REPO / "scenarios/nutation-damper.yaml").read_text()
+    shipped = polhode.linearize(polhode.loads(text))["nutation"]
+    assert shipped["energy_sink_valid"] is True
+    assert shipped["energy_sink_warning"] is None
+    soft = text.replace("stiffness: 52.744 ", "stiffness: 1.0 ").replace(
+        "damping: 105.49 ", "damping: 1.0 "
+    )
+    assert soft != text
+    nutation = polhode.linearize(polhode.loads(soft))["nutation"]
+    assert nutation["energy_sink_valid"] is False
+    assert "past the 25%" in nutation["energy_sink_warning"]
+    off = (nutation["energy_sink_rate"] - nutation["rate"]) / abs(nutation["rate"])
+    assert abs(off) > 10.0
