@@ -134,3 +134,10 @@ pub mod scenario;
 pub mod sim;
 pub mod sincos;
 pub mod timefmt;
+
+/// The README's Rust example: through this item `cargo test --doc` compiles and runs every
+/// `rust` block of README.md (its other blocks are tagged `sh`, `python`, `text`, `yaml` and
+/// are not compiled), so the code shown on the front page cannot drift from the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExamples;

@@ -532,3 +532,140 @@ duration: 10.0
         stable.deciding_mode
     );
 }
+
+/// The shipped nutation damper (a 52.7 kg mass 1 m off the axis of a 5274 kg bus, k = 52.7 N/m,
+/// ζ = 1) with its spring made fifty times softer, k = 1 N/m, c = 1 N s/m: the damper's
+/// inertia μr² ≈ 52 kg m² is larger than the bus's margin I₃ − I₁ = 27 kg m² that makes z the
+/// major axis, so the damper is no weakly coupled sink and the locked body's nutation no longer
+/// describes the motion.
+fn soft_nutation_damper() -> String {
+    let shipped = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/nutation-damper.yaml"),
+    )
+    .unwrap();
+    let soft = shipped
+        .replace("stiffness: 52.744 ", "stiffness: 1.0 ")
+        .replace("damping: 105.49 ", "damping: 1.0 ");
+    assert_ne!(soft, shipped, "the shipped damper's keys moved");
+    soft
+}
+
+/// `linearize` on a scene far outside the energy-sink argument's assumptions (the issue's
+/// "+9391 % from the eigenvalue"): no number is printed as the estimate, a warning gives the
+/// reason and the threshold, and `--json` has `energy_sink_valid: false` with the warning. The
+/// shipped damper, inside them (+9.5 %), keeps its estimate and `energy_sink_valid: true`.
+/// That the soft damper's formula is wrong, and not only far from the eigenvalue, is checked
+/// by integrating the nonlinear equations: from a 0.06° wobble the nutation angle grows more
+/// than tenfold in 60 s, while the formula claims a decay.
+#[test]
+fn an_energy_sink_estimate_outside_its_assumptions_is_a_warning_not_a_number() {
+    let dir = std::env::temp_dir().join(format!("polhode-energy-sink-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let soft = dir.join("soft.yaml");
+    std::fs::write(&soft, soft_nutation_damper()).unwrap();
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/nutation-damper.yaml");
+    let text = |path: &Path| {
+        let out = polhode().arg("linearize").arg(path).output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let json = |path: &Path| -> serde_json::Value {
+        let out = polhode()
+            .arg("linearize")
+            .arg(path)
+            .args(["--json", "-"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+
+    let printed = text(&soft);
+    assert!(
+        printed.contains("energy-sink estimate: none (outside its assumptions here)"),
+        "{printed}"
+    );
+    assert!(!printed.contains("% from the eigenvalue"), "{printed}");
+    let warning = printed
+        .lines()
+        .find(|l| l.contains("warning: the energy-sink formula gives a rate"))
+        .unwrap_or_else(|| panic!("{printed}"));
+    assert!(
+        warning.contains("past the 25%") && warning.contains("use the eigenvalue"),
+        "{warning}"
+    );
+    let v = json(&soft);
+    let n = &v["nutation"];
+    assert_eq!(n["energy_sink_valid"], false, "{n}");
+    assert_eq!(
+        format!("  warning: {}", n["energy_sink_warning"].as_str().unwrap()),
+        warning
+    );
+    let (rate, formula) = (
+        n["rate"].as_f64().unwrap(),
+        n["energy_sink_rate"].as_f64().unwrap(),
+    );
+    // Off by a factor of tens, as in the issue.
+    assert!(((formula - rate) / rate.abs()).abs() > 10.0, "{n}");
+
+    let printed = text(&shipped);
+    assert!(
+        printed.contains("energy-sink estimate: -2.85")
+            && printed.contains("+9.5% from the eigenvalue"),
+        "{printed}"
+    );
+    assert!(!printed.contains("warning"), "{printed}");
+    let v = json(&shipped);
+    assert_eq!(v["nutation"]["energy_sink_valid"], true);
+    assert_eq!(
+        v["nutation"]["energy_sink_warning"],
+        serde_json::Value::Null
+    );
+
+    // The nonlinear run of the soft damper from a small wobble.
+    let wobble = dir.join("wobble.yaml");
+    std::fs::write(
+        &wobble,
+        soft_nutation_damper().replace("omega: [0.1, 0.0, 1.0]", "omega: [0.001, 0.0, 1.0]"),
+    )
+    .unwrap();
+    let csv = dir.join("wobble.csv");
+    let out = polhode()
+        .arg("run")
+        .arg(&wobble)
+        .args(["--no-log", "-q", "--duration", "60", "--csv"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = table.lines();
+    let column = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h.starts_with("nutation_angle_deg "))
+        .unwrap();
+    let angles: Vec<f64> = lines
+        .map(|l| l.split(',').nth(column).unwrap().parse().unwrap())
+        .collect();
+    let (first, last) = (angles[0], *angles.last().unwrap());
+    assert!(formula < 0.0, "the formula claims a decay: {formula}");
+    assert!(
+        last > 10.0 * first,
+        "the nutation angle went from {first}° to {last}° in 60 s"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -19,6 +19,9 @@ const Q_LVLH: [u64; 4] = [10, 11, 12, 13];
 const ROLL: u64 = 14;
 const PITCH: u64 = 15;
 const YAW: u64 = 16;
+const OMEGA_LVLH: [u64; 3] = [17, 18, 19];
+/// `/telemetry` field numbers of ω_BN (rad/s, body axes).
+const OMEGA: [u64; 3] = [2, 3, 4];
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("polhode-orbit-log-{}-{name}", std::process::id()));
@@ -266,10 +269,12 @@ fn a_scenario_with_an_orbit_logs_it_and_the_lvlh_frame() {
         ("roll_deg", "deg"),
         ("pitch_deg", "deg"),
         ("yaw_deg", "deg"),
+        ("omega_lvlh_x", "rad/s"),
+        ("omega_lvlh_z", "rad/s"),
     ] {
         assert_eq!(units[field], unit, "{field}");
     }
-    assert_eq!(units.as_object().unwrap().len(), 16);
+    assert_eq!(units.as_object().unwrap().len(), 19);
 
     let orbit = messages(&bytes, "/orbit");
     let telemetry = messages(&bytes, "/telemetry");
@@ -280,7 +285,9 @@ fn a_scenario_with_an_orbit_logs_it_and_the_lvlh_frame() {
     assert_eq!(times(&orbit), times(&telemetry));
     assert_eq!(tf.len(), orbit.len());
 
-    for (k, ((_, data), transforms)) in orbit.iter().zip(&tf).enumerate() {
+    for (k, (((_, data), transforms), (_, hub))) in
+        orbit.iter().zip(&tf).zip(&telemetry).enumerate()
+    {
         let o = doubles(data);
         let t = get(&o, SIM_TIME);
         assert_eq!(t, 2.0 * k as f64);
@@ -377,6 +384,26 @@ fn a_scenario_with_an_orbit_logs_it_and_the_lvlh_frame() {
         assert!(
             1.0 - dot.abs() < 1e-12,
             "t = {t}: q_NO q_OB != q_NB ({dot})"
+        );
+
+        // The body rate relative to LVLH: ω_BO = ω_BN − C_BN ω_ON, with the frame's rate of a
+        // two-body orbit ω_ON = r × v / |r|² (ECI) written out here from the logged r and v.
+        let rxv = [
+            r[1] * v[2] - r[2] * v[1],
+            r[2] * v[0] - r[0] * v[2],
+            r[0] * v[1] - r[1] * v[0],
+        ];
+        let r2: f64 = r.iter().map(|x| x * x).sum();
+        let w_on = rxv.map(|x| x / r2);
+        let q_body = wxyz(&body.rotation);
+        let conj = [q_body[0], -q_body[1], -q_body[2], -q_body[3]];
+        let in_body = mul(mul(conj, [0.0, w_on[0], w_on[1], w_on[2]]), q_body);
+        let hub = doubles(hub);
+        let expect: [f64; 3] = std::array::from_fn(|i| get(&hub, OMEGA[i]) - in_body[i + 1]);
+        let got = OMEGA_LVLH.map(|i| get(&o, i));
+        assert!(
+            norm(sub(got, expect)) < 1e-12,
+            "t = {t}: omega_lvlh {got:?} rad/s, from r, v and ω_BN {expect:?}"
         );
 
         if k == 0 {

@@ -41,15 +41,19 @@ fn read_samples(log: &Path, csv: &Path, parquet: &Path) -> (bool, String) {
     )
 }
 
-/// Scenes with effectors (a held wheel and a damper; coils in orbit) and without: the CSV
-/// and the Parquet file hold the log's samples bit for bit, with its units. A table edited
-/// by one digit fails the check.
+/// Scenes with effectors (a held wheel and a damper; coils in orbit) and without, in orbit
+/// and not: the CSV and the Parquet file hold the log's samples bit for bit, with its units
+/// (in orbit the attitude relative to LVLH equals the log's /orbit fields, by name); a scene
+/// without an orbit has no LVLH column. A table edited by one digit fails the check.
 #[test]
 fn tables_equal_the_log_in_an_independent_reader() {
     let dir = scratch("equal");
     for (scene, columns) in [
         ("dual-spin", 38),
-        ("cubesat-detumble", 38),
+        // In orbit: 38 columns, then the attitude relative to LVLH (the /orbit fields).
+        ("cubesat-detumble", 48),
+        // In orbit: the 26 /telemetry fields, the gravity gradient's five, the ten LVLH ones.
+        ("gravity-gradient-smallsat", 41),
         ("tennis-racket", 26),
     ] {
         let (log, csv, parquet) = (

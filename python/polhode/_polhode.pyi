@@ -35,13 +35,33 @@ class Result:
     def q(self) -> npt.NDArray[np.float64]:
         """Attitude quaternion body->inertial, scalar-first (w, x, y, z), shape (n, 4)."""
     @property
+    def q_lvlh(self) -> Optional[npt.NDArray[np.float64]]:
+        """Attitude relative to LVLH, body->LVLH, scalar-first, w >= 0, shape (n, 4).
+
+        The ``/orbit`` fields ``q_lvlh_*``; None for a scenario without an orbit.
+        """
+    @property
+    def lvlh_rpy(self) -> Optional[npt.NDArray[np.float64]]:
+        """Roll, pitch, yaw relative to LVLH (deg, 3-2-1 Euler angles), shape (n, 3).
+
+        The ``/orbit`` fields ``roll_deg``, ``pitch_deg``, ``yaw_deg``; None without an orbit.
+        """
+    @property
+    def omega_lvlh(self) -> Optional[npt.NDArray[np.float64]]:
+        """Body rates relative to LVLH in the body frame (rad/s), shape (n, 3).
+
+        The ``/orbit`` fields ``omega_lvlh_*``; None for a scenario without an orbit.
+        """
+    @property
     def telemetry(self) -> Dict[str, npt.NDArray[np.float64]]:
         """The columns of ``polhode run --csv`` by name, each of shape (n,).
 
         Every ``/telemetry`` field of the MCAP log (``sim_time`` s, ``omega_x`` rad/s,
         ``h_norm`` N m s, ``kinetic_energy`` J, ``nutation_angle_deg`` deg, ...; units in
         docs/logs.md), then each effector's fields as ``<effector>.<field>``
-        (``wheel.rate`` rad/s, ``damper.offset`` m, ...). Views of one buffer, no copy.
+        (``wheel.rate`` rad/s, ``damper.offset`` m, ...), then with an orbit the attitude
+        relative to LVLH (``q_lvlh_*``, ``roll_deg``, ``pitch_deg``, ``yaw_deg``,
+        ``omega_lvlh_*``). Views of one buffer, no copy.
         """
     @property
     def events(self) -> List[Dict[str, Any]]:

@@ -21,8 +21,21 @@ pub(crate) struct RunResult {
     /// Attitude quaternion body→inertial, scalar-first (w, x, y, z), shape (n, 4).
     #[pyo3(get)]
     pub(crate) q: Py<PyAny>,
+    /// Attitude relative to LVLH, `q_OB` body→LVLH, scalar-first, sign with w ≥ 0, shape
+    /// (n, 4); `None` without an orbit. The `/orbit` fields `q_lvlh_*`.
+    #[pyo3(get)]
+    pub(crate) q_lvlh: Option<Py<PyAny>>,
+    /// Roll, pitch, yaw relative to LVLH (deg; 3-2-1 Euler angles of `q_lvlh`), shape (n, 3);
+    /// `None` without an orbit. The `/orbit` fields `roll_deg`, `pitch_deg`, `yaw_deg`.
+    #[pyo3(get)]
+    pub(crate) lvlh_rpy: Option<Py<PyAny>>,
+    /// Body rates relative to LVLH (rad/s, body frame), shape (n, 3); `None` without an
+    /// orbit. The `/orbit` fields `omega_lvlh_*`.
+    #[pyo3(get)]
+    pub(crate) omega_lvlh: Option<Py<PyAny>>,
     /// Every `/telemetry` field of the MCAP log, then every effector's fields as
-    /// `<effector>.<field>` (the columns of `polhode run --csv`), each of shape (n,).
+    /// `<effector>.<field>`, then with an orbit the attitude relative to LVLH (the columns of
+    /// `polhode run --csv`), each of shape (n,).
     #[pyo3(get)]
     pub(crate) telemetry: Py<PyDict>,
     /// Events in time order: dicts with `t` (s), `condition` and `terminal`.
@@ -43,6 +56,8 @@ pub(crate) struct RunResult {
 /// Rows of the `omega_*` and `q_*` columns in [`telemetry::FIELDS`].
 pub(crate) const OMEGA_ROWS: (usize, usize) = (1, 4);
 pub(crate) const Q_ROWS: (usize, usize) = (4, 8);
+/// Columns of the attitude relative to LVLH, last in the buffer with an orbit.
+const LVLH_COLUMNS: usize = polhode::log::orbit::ATTITUDE_FIELDS.len();
 
 impl RunResult {
     pub(crate) fn new(py: Python<'_>, p: Products) -> PyResult<Self> {
@@ -56,6 +71,16 @@ impl RunResult {
         let t = block.get_item(0)?;
         let omega = rows_t(OMEGA_ROWS)?;
         let q = rows_t(Q_ROWS)?;
+        // The attitude relative to LVLH: the last ten columns, with an orbit.
+        let lvlh = |(a, b): (usize, usize)| -> PyResult<Option<Py<PyAny>>> {
+            p.has_lvlh
+                .then(|| {
+                    let first = p.names.len() - LVLH_COLUMNS;
+                    rows_t((first + a, first + b)).map(Bound::unbind)
+                })
+                .transpose()
+        };
+        let (q_lvlh, lvlh_rpy, omega_lvlh) = (lvlh((0, 4))?, lvlh((4, 7))?, lvlh((7, 10))?);
         let telemetry = PyDict::new(py);
         let units = PyDict::new(py);
         for (k, (name, unit)) in p.names.iter().zip(&p.units).enumerate() {
@@ -77,6 +102,9 @@ impl RunResult {
             t: t.unbind(),
             omega: omega.unbind(),
             q: q.unbind(),
+            q_lvlh,
+            lvlh_rpy,
+            omega_lvlh,
             telemetry: telemetry.unbind(),
             events: events.unbind(),
             summary: summary.unbind(),

@@ -3,6 +3,7 @@
 
 use polhode::log::{McapLogger, samples};
 use polhode::model::{Observation, Spacecraft};
+use polhode::orbit::Orbit;
 use polhode::scenario::{self, Overrides};
 use polhode::sim::{self, Control, EventRecord, Outcome, Reference, Sink, Warning};
 use std::path::Path;
@@ -81,6 +82,8 @@ fn zeroed(n: usize) -> Result<Vec<f64>, String> {
 /// `polhode run --csv`) and forwards everything to the MCAP log when there is one.
 pub(crate) struct Collector<'a> {
     pub(crate) spacecraft: &'a Spacecraft,
+    /// The scenario's orbit, if any: the attitude relative to LVLH is then collected too.
+    pub(crate) orbit: Option<&'a Orbit>,
     pub(crate) store: ColumnStore,
     /// The current sample's values (scratch).
     pub(crate) row: Vec<f64>,
@@ -90,7 +93,7 @@ pub(crate) struct Collector<'a> {
 
 impl Sink for Collector<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> std::io::Result<()> {
-        samples::fill_row(&mut self.row, self.spacecraft, o, y, inv);
+        samples::fill_row(&mut self.row, self.spacecraft, self.orbit, o, y, inv);
         self.store.push(&self.row)?;
         match self.log.as_mut() {
             Some(log) => log.sample(o, y, inv),
@@ -115,10 +118,13 @@ impl Sink for Collector<'_> {
 
 /// What a finished run hands back to the calling thread.
 pub(crate) struct Products {
-    /// Column names: the `/telemetry` fields, then `<effector>.<field>`.
+    /// Column names: the `/telemetry` fields, then `<effector>.<field>`, then with an orbit
+    /// the attitude relative to LVLH (`polhode::log::orbit::ATTITUDE_FIELDS`).
     pub(crate) names: Vec<String>,
     /// Each column's unit (`rad/s`; `""` when it has none), as the `--csv` header gives it.
     pub(crate) units: Vec<String>,
+    /// Whether the last columns are the attitude relative to LVLH (the scenario has an orbit).
+    pub(crate) has_lvlh: bool,
     /// The columns back to back, `n` values each.
     pub(crate) columns: Vec<f64>,
     /// Output samples.
@@ -160,10 +166,11 @@ pub(crate) fn execute(
             .check()
             .map_err(RunError::Refused)?;
     }
-    let (names, units): (Vec<String>, Vec<String>) = samples::columns(&s.spacecraft)
-        .into_iter()
-        .map(|c| (c.name, c.unit))
-        .unzip();
+    let (names, units): (Vec<String>, Vec<String>) =
+        samples::columns(&s.spacecraft, s.orbit.as_deref())
+            .into_iter()
+            .map(|c| (c.name, c.unit))
+            .unzip();
     // Known before anything is allocated or integrated: refused with the numbers.
     polhode::resources::check_sample_memory(
         &format!("{}: the run's samples", s.path.display()),
@@ -207,6 +214,7 @@ pub(crate) fn execute(
     };
     let mut collector = Collector {
         spacecraft: &s.spacecraft,
+        orbit: s.orbit.as_deref(),
         store,
         row: Vec::with_capacity(names.len()),
         log: logger,
@@ -241,6 +249,7 @@ pub(crate) fn execute(
     Ok(Products {
         names,
         units,
+        has_lvlh: s.orbit.is_some(),
         columns: collector.store.into_columns(),
         n,
         outcome,

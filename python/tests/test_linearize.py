@@ -45,3 +45,21 @@ def test_linearize_wants_a_scenario_or_a_path():
     # A path is loaded (test_arguments.py); anything else is a TypeError.
     with pytest.raises(TypeError, match=r"^linearize\(\): scenario must be"):
         polhode.linearize(3.5)
+
+
+def test_an_energy_sink_estimate_outside_its_assumptions_is_flagged():
+    """The nutation damper as shipped (+9.5 % from the eigenvalue) has a valid estimate; with
+    a spring fifty times softer it is thousands of percent off and flagged, with the reason."""
+    text = (REPO / "scenarios/nutation-damper.yaml").read_text()
+    shipped = polhode.linearize(polhode.loads(text))["nutation"]
+    assert shipped["energy_sink_valid"] is True
+    assert shipped["energy_sink_warning"] is None
+    soft = text.replace("stiffness: 52.744 ", "stiffness: 1.0 ").replace(
+        "damping: 105.49 ", "damping: 1.0 "
+    )
+    assert soft != text
+    nutation = polhode.linearize(polhode.loads(soft))["nutation"]
+    assert nutation["energy_sink_valid"] is False
+    assert "past the 25%" in nutation["energy_sink_warning"]
+    off = (nutation["energy_sink_rate"] - nutation["rate"]) / abs(nutation["rate"])
+    assert abs(off) > 10.0

@@ -184,7 +184,10 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
             ),
             None => println!("  nutation: neutral, frequency {:.6e} rad/s", n.frequency),
         }
-        if let (Some(r), Some(tc), Some(d)) = (
+        if let Some(warning) = &n.energy_sink_warning {
+            println!("  energy-sink estimate: none (outside its assumptions here)");
+            println!("  warning: {warning}");
+        } else if let (Some(r), Some(tc), Some(d)) = (
             n.energy_sink_rate,
             n.energy_sink_time_constant,
             n.energy_sink_difference(),
@@ -194,27 +197,26 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
                  the eigenvalue",
                 100.0 * d
             );
-            if n.energy_sink_unreliable() {
-                println!(
-                    "  warning: the energy-sink estimate is {:+.0}% off the eigenvalue, past \
-                     the {:.0}% its assumptions allow (the effectors following the locked \
-                     body's nutation, away from resonance with it): use the eigenvalue",
-                    100.0 * d,
-                    100.0 * crate::linearize::ENERGY_SINK_DISAGREEMENT
-                );
-            }
         }
         if let Some(w) = &n.dual_spin_energy_sink {
-            let tc = w
-                .time_constant
-                .map(|t| format!(" (time constant {t:.6} s)"))
-                .unwrap_or_default();
-            println!(
-                "  weighted (dual-spin) energy-sink estimate: {:.9e} 1/s{tc}, {:+.1}% from the \
-                 eigenvalue",
-                w.rate,
-                100.0 * w.relative_difference
-            );
+            if let Some(warning) = &w.warning {
+                println!(
+                    "  weighted (dual-spin) energy-sink estimate: none (outside its assumptions \
+                     here)"
+                );
+                println!("  warning: {warning}");
+            } else {
+                let tc = w
+                    .time_constant
+                    .map(|t| format!(" (time constant {t:.6} s)"))
+                    .unwrap_or_default();
+                println!(
+                    "  weighted (dual-spin) energy-sink estimate: {:.9e} 1/s{tc}, {:+.1}% from \
+                     the eigenvalue",
+                    w.rate,
+                    100.0 * w.relative_difference
+                );
+            }
             for b in &w.bodies {
                 println!(
                     "    nutation seen in {} (spin {:.6e} rad/s): λ = {:+.6e} rad/s",
@@ -227,7 +229,8 @@ fn print_linearization(s: &Scenario, lin: &Linearization) {
                     b.nutation_frequency
                 );
             }
-            for k in &w.sinks {
+            // Each sink's share of the estimate, only when there is one.
+            for k in w.sinks.iter().filter(|_| w.valid) {
                 println!(
                     "    `{}` on the {}: {:+.9e} 1/s",
                     k.effector, k.body, k.rate

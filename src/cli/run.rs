@@ -56,8 +56,12 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
         return EXIT_BAD_INPUT;
     }
     let mut table = if outputs.csv.is_some() || outputs.parquet.is_some() {
-        match crate::log::samples::SampleTable::create(&s.spacecraft, outputs.csv, outputs.parquet)
-        {
+        match crate::log::samples::SampleTable::create(
+            &s.spacecraft,
+            s.orbit.as_deref(),
+            outputs.csv,
+            outputs.parquet,
+        ) {
             Ok(t) => Some(t),
             Err(e) => {
                 eprintln!(

@@ -109,6 +109,12 @@ pub struct Nutation {
     pub energy_sink_rate: Option<f64>,
     /// 1/|energy_sink_rate| (s).
     pub energy_sink_time_constant: Option<f64>,
+    /// Whether `energy_sink_rate` is an estimate here: within [`ENERGY_SINK_DISAGREEMENT`] of
+    /// the eigenvalue's rate (`None` without an estimate). When `false` the number is outside
+    /// the estimate's assumptions and only the eigenvalue stands.
+    pub energy_sink_valid: Option<bool>,
+    /// Why `energy_sink_rate` is not an estimate here, when `energy_sink_valid` is `false`.
+    pub energy_sink_warning: Option<String>,
     /// The weighted (dual-spin) energy-sink estimate, for a gyrostat whose rotors spin
     /// relative to the hub, when effectors with their own states dissipate energy.
     pub dual_spin_energy_sink: Option<DualSpinEnergySink>,
@@ -119,6 +125,22 @@ pub struct Nutation {
 /// coupled system"): a damper near resonance with the nutation, or one that does not follow
 /// the locked body's motion.
 pub const ENERGY_SINK_DISAGREEMENT: f64 = 0.25;
+
+/// The reason an energy-sink estimate `relative_difference` ((estimate − eigenvalue
+/// rate)/|eigenvalue rate|) off the eigenvalue is no estimate, when it is past
+/// [`ENERGY_SINK_DISAGREEMENT`]; `None` within it.
+pub fn energy_sink_warning(relative_difference: f64) -> Option<String> {
+    (relative_difference.abs() > ENERGY_SINK_DISAGREEMENT).then(|| {
+        format!(
+            "the energy-sink formula gives a rate {:+.0}% off the eigenvalue, past the {:.0}% \
+             its assumptions allow (the effectors following the locked body's nutation, away \
+             from resonance with it, weakly coupled to it): it is no estimate here, use the \
+             eigenvalue",
+            100.0 * relative_difference,
+            100.0 * ENERGY_SINK_DISAGREEMENT
+        )
+    })
+}
 
 impl Nutation {
     /// (estimate − eigenvalue rate)/|eigenvalue rate| of the energy-sink estimate, when there
@@ -131,8 +153,7 @@ impl Nutation {
     /// Whether the energy-sink estimate is outside its assumptions here: it differs from the
     /// eigenvalue by more than [`ENERGY_SINK_DISAGREEMENT`].
     pub fn energy_sink_unreliable(&self) -> bool {
-        self.energy_sink_difference()
-            .is_some_and(|d| d.abs() > ENERGY_SINK_DISAGREEMENT)
+        self.energy_sink_valid == Some(false)
     }
 }
 
@@ -651,12 +672,16 @@ pub fn linearize(sc: &Spacecraft, spin_rate: f64) -> Result<Linearization, Strin
                 },
             )
         });
+        let energy_sink_warning = estimate
+            .and_then(|r| energy_sink_warning((r - v.re) / v.re.abs().max(f64::MIN_POSITIVE)));
         Nutation {
             rate: v.re,
             frequency: v.im.abs(),
             time_constant: (v.re.abs() > zero).then(|| 1.0 / v.re.abs()),
             energy_sink_rate: estimate,
             energy_sink_time_constant: estimate.filter(|r| r.abs() > 0.0).map(|r| 1.0 / r.abs()),
+            energy_sink_valid: estimate.map(|_| energy_sink_warning.is_none()),
+            energy_sink_warning,
             dual_spin_energy_sink,
         }
     });
@@ -967,6 +992,11 @@ pub struct DualSpinEnergySink {
     /// (rate − the nutation eigenvalue's real part) / |that real part|: the estimate's error
     /// against the eigenvalue, the reference.
     pub relative_difference: f64,
+    /// Whether `rate` is an estimate here: `relative_difference` within
+    /// [`ENERGY_SINK_DISAGREEMENT`]. When `false` only the eigenvalue stands.
+    pub valid: bool,
+    /// Why `rate` is not an estimate here, when `valid` is `false`.
+    pub warning: Option<String>,
     /// The bodies turning about the spin axis: the hub first, then each rotor spinning
     /// relative to it.
     pub bodies: Vec<BodyNutation>,
@@ -1084,11 +1114,15 @@ fn dual_spin_energy_sink(
             nutation_frequency: lambda_hub - sense * relative,
         });
     }
+    let relative_difference =
+        (rate - steady.eigen_rate) / steady.eigen_rate.abs().max(f64::MIN_POSITIVE);
+    let warning = energy_sink_warning(relative_difference);
     Some(DualSpinEnergySink {
         rate,
         time_constant: (rate != 0.0).then(|| 1.0 / rate.abs()),
-        relative_difference: (rate - steady.eigen_rate)
-            / steady.eigen_rate.abs().max(f64::MIN_POSITIVE),
+        relative_difference,
+        valid: warning.is_none(),
+        warning,
         bodies,
         sinks,
     })

@@ -625,7 +625,10 @@ impl<'a> McapLogger<'a> {
         per_sample += self.buf.len() as f64 + PER_MESSAGE;
         if let Some(orbit) = &self.orbit {
             // Every field is written (zeros too), so any instant encodes to the same length.
-            telemetry::encode_doubles(&orbit::values(orbit, 0.0, &o.attitude), &mut self.buf);
+            telemetry::encode_doubles(
+                &orbit::values(orbit, 0.0, &o.attitude, &o.omega),
+                &mut self.buf,
+            );
             per_sample += self.buf.len() as f64 + PER_MESSAGE;
         }
         let hub = HubState {
@@ -928,7 +931,7 @@ impl Sink for McapLogger<'_> {
         telemetry::encode_doubles(&values, &mut self.buf);
         self.write_raw(self.channels.telemetry, self.log_time(o.t))?;
         if let (Some(channel), Some(orbit)) = (self.channels.orbit, &self.orbit) {
-            let values = orbit::values(orbit, o.t, &o.attitude);
+            let values = orbit::values(orbit, o.t, &o.attitude, &o.omega);
             telemetry::encode_doubles(&values, &mut self.buf);
             self.write_raw(channel, self.log_time(o.t))?;
         }

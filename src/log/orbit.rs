@@ -7,17 +7,22 @@
 //! `w ≥ 0`), and its 3-2-1 Euler angles are the aerospace sequence (Wertz 1978, §12.1 and
 //! appendix E; Sidi 1997): yaw ψ about `o3`, then pitch θ about the new 2 axis, then
 //! roll φ about the new 1 axis, `R(q_OB) = R_z(ψ) R_y(θ) R_x(φ)`; φ, ψ in (−180°, 180°],
-//! θ in [−90°, 90°].
+//! θ in [−90°, 90°]. The body's rate relative to LVLH is `ω_BO = ω_BN − C_BN ω_ON` in body
+//! components (`ω_ON` the LVLH frame's rate, [`crate::orbit::Lvlh::omega`]).
+//!
+//! The attitude relative to LVLH, [`ATTITUDE_FIELDS`] (the last ten of [`FIELDS`]), is also a
+//! set of columns of the sample tables and the Python `Result` ([`super::samples`]), computed by
+//! the same [`attitude_values`].
 
 use super::{telemetry, units};
 use crate::orbit::Orbit;
-use nalgebra::UnitQuaternion;
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// Fully qualified schema name.
 pub const SCHEMA_NAME: &str = "polhode.Orbit";
 
 /// Field names in field-number order (field `i` has number `i + 1`).
-pub const FIELDS: [&str; 16] = [
+pub const FIELDS: [&str; 19] = [
     "sim_time",
     "r_eci_x",
     "r_eci_y",
@@ -34,6 +39,27 @@ pub const FIELDS: [&str; 16] = [
     "roll_deg",
     "pitch_deg",
     "yaw_deg",
+    "omega_lvlh_x",
+    "omega_lvlh_y",
+    "omega_lvlh_z",
+];
+
+/// Index in [`FIELDS`] of the first of [`ATTITUDE_FIELDS`].
+pub const ATTITUDE_START: usize = 9;
+
+/// The attitude relative to LVLH: `q_OB`, its 3-2-1 angles (deg) and `ω_BO` (rad/s, body
+/// axes); the columns the sample tables add for a scenario with an orbit.
+pub const ATTITUDE_FIELDS: [&str; 10] = [
+    "q_lvlh_w",
+    "q_lvlh_x",
+    "q_lvlh_y",
+    "q_lvlh_z",
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "omega_lvlh_x",
+    "omega_lvlh_y",
+    "omega_lvlh_z",
 ];
 
 /// The serialized `FileDescriptorSet` of [`FIELDS`] as proto3 doubles.
@@ -65,12 +91,44 @@ pub fn euler_321(q: &UnitQuaternion<f64>) -> (f64, f64, f64) {
     (roll, pitch, yaw)
 }
 
-/// The values of [`FIELDS`] at sim time `t` for the body attitude `attitude` (`q_NB`).
-pub fn values(orbit: &Orbit, t: f64, attitude: &UnitQuaternion<f64>) -> [f64; 16] {
-    let (r, v) = orbit.state(t);
-    let q = body_in_lvlh(&orbit.lvlh(t).lvlh_to_eci(), attitude);
+/// The values of [`ATTITUDE_FIELDS`] at sim time `t` (s) for the body attitude `attitude`
+/// (`q_NB`) and body rate `omega` (`ω_BN`, rad/s, body axes): `q_OB`, roll, pitch, yaw (deg),
+/// `ω_BO` (rad/s, body axes).
+pub fn attitude_values(
+    orbit: &Orbit,
+    t: f64,
+    attitude: &UnitQuaternion<f64>,
+    omega: &Vector3<f64>,
+) -> [f64; 10] {
+    let lvlh = orbit.lvlh(t);
+    let q = body_in_lvlh(&lvlh.lvlh_to_eci(), attitude);
     let (roll, pitch, yaw) = euler_321(&q);
+    let omega_rel = omega - attitude.inverse_transform_vector(&lvlh.omega);
     [
+        q.w,
+        q.i,
+        q.j,
+        q.k,
+        roll.to_degrees(),
+        pitch.to_degrees(),
+        yaw.to_degrees(),
+        omega_rel.x,
+        omega_rel.y,
+        omega_rel.z,
+    ]
+}
+
+/// The values of [`FIELDS`] at sim time `t` (s) for the body attitude `attitude` (`q_NB`)
+/// and body rate `omega` (`ω_BN`, rad/s, body axes).
+pub fn values(
+    orbit: &Orbit,
+    t: f64,
+    attitude: &UnitQuaternion<f64>,
+    omega: &Vector3<f64>,
+) -> [f64; 19] {
+    let (r, v) = orbit.state(t);
+    let mut out = [0.0; 19];
+    out[..ATTITUDE_START].copy_from_slice(&[
         t,
         r[0] / 1e3,
         r[1] / 1e3,
@@ -80,20 +138,14 @@ pub fn values(orbit: &Orbit, t: f64, attitude: &UnitQuaternion<f64>) -> [f64; 16
         v[2] / 1e3,
         orbit.altitude(t) / 1e3,
         orbit.argument_of_latitude(t).to_degrees(),
-        q.w,
-        q.i,
-        q.j,
-        q.k,
-        roll.to_degrees(),
-        pitch.to_degrees(),
-        yaw.to_degrees(),
-    ]
+    ]);
+    out[ATTITUDE_START..].copy_from_slice(&attitude_values(orbit, t, attitude, omega));
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::Vector3;
 
     #[test]
     fn euler_angles_follow_the_3_2_1_sequence() {
@@ -115,6 +167,11 @@ mod tests {
         let q = body_in_lvlh(&q_no, &(q_no * q_ob));
         assert!(q.w >= 0.0);
         assert!(q.angle_to(&q_ob) < 1e-12);
+    }
+
+    #[test]
+    fn the_attitude_fields_are_the_tail_of_the_fields() {
+        assert_eq!(FIELDS[ATTITUDE_START..], ATTITUDE_FIELDS);
     }
 
     #[test]

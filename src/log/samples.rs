@@ -1,6 +1,9 @@
 //! One run's sampled telemetry as a table (`polhode run --csv FILE --parquet FILE`): a row
 //! per output sample, the `/telemetry` fields then every effector's fields as
-//! `<effector>.<field>`, the same numbers as the MCAP log's.
+//! `<effector>.<field>`, then, for a scenario with an orbit, the attitude relative to LVLH
+//! ([`orbit::ATTITUDE_FIELDS`]: `q_lvlh_*`, `roll_deg`, `pitch_deg`, `yaw_deg`,
+//! `omega_lvlh_*`); the same numbers as the MCAP log's `/telemetry`, `/effectors/*` and
+//! `/orbit`. Without an orbit those columns are absent and nothing is computed for them.
 //!
 //! - **CSV**: a header whose names carry their units, `omega_x [rad/s]`; numbers in Rust's
 //!   shortest round-trip form, so the text reads back bit for bit.
@@ -12,9 +15,11 @@
 //! when the run ends, so memory stays flat and a final name never holds a half-written table.
 
 use super::TempFile;
+use super::orbit;
 use super::telemetry::{self, FIELDS};
 use super::units;
 use crate::model::{HubState, Observation, Spacecraft};
+use crate::orbit::Orbit;
 use crate::sim::{EventRecord, Reference, Sink, Warning};
 use parquet::basic::{Repetition, Type as PhysicalType};
 use parquet::data_type::DoubleType;
@@ -39,8 +44,9 @@ pub struct Column {
     pub unit: String,
 }
 
-/// The columns of a run of `spacecraft`: the `/telemetry` fields, then each effector's.
-pub fn columns(spacecraft: &Spacecraft) -> Vec<Column> {
+/// The columns of a run of `spacecraft`: the `/telemetry` fields, then each effector's, then
+/// with an `orbit` the attitude relative to LVLH ([`orbit::ATTITUDE_FIELDS`]).
+pub fn columns(spacecraft: &Spacecraft, orbit: Option<&Orbit>) -> Vec<Column> {
     let unit_of = |kind: &str, field: &str| {
         units::field_unit(kind, field)
             .map(|(_, u)| u.to_string())
@@ -60,6 +66,12 @@ pub fn columns(spacecraft: &Spacecraft) -> Vec<Column> {
                 unit: unit_of(e.kind(), &f),
             });
         }
+    }
+    if orbit.is_some() {
+        out.extend(orbit::ATTITUDE_FIELDS.iter().map(|f| Column {
+            name: f.to_string(),
+            unit: unit_of(units::ORBIT, f),
+        }));
     }
     out
 }
@@ -95,6 +107,7 @@ struct ParquetOut {
 /// A [`Sink`] writing the sampled telemetry to CSV and/or Parquet.
 pub struct SampleTable<'a> {
     spacecraft: &'a Spacecraft,
+    orbit: Option<&'a Orbit>,
     csv: Option<(Pending, BufWriter<File>)>,
     parquet: Option<ParquetOut>,
     row: Vec<f64>,
@@ -102,14 +115,16 @@ pub struct SampleTable<'a> {
 }
 
 impl<'a> SampleTable<'a> {
-    /// Opens the tables (either may be `None`) for a run of `spacecraft`. Fails before the
+    /// Opens the tables (either may be `None`) for a run of `spacecraft`, in `orbit` when
+    /// there is one (its attitude relative to LVLH is then tabulated too). Fails before the
     /// run when a target cannot be written.
     pub fn create(
         spacecraft: &'a Spacecraft,
+        orbit: Option<&'a Orbit>,
         csv: Option<&Path>,
         parquet: Option<&Path>,
     ) -> io::Result<SampleTable<'a>> {
-        let cols = columns(spacecraft);
+        let cols = columns(spacecraft, orbit);
         let csv = match csv {
             None => None,
             Some(path) => {
@@ -185,6 +200,7 @@ impl<'a> SampleTable<'a> {
         };
         Ok(SampleTable {
             spacecraft,
+            orbit,
             csv,
             parquet,
             row: Vec::with_capacity(cols.len()),
@@ -236,8 +252,16 @@ impl<'a> SampleTable<'a> {
 }
 
 /// Fills `row` with one sample's values in [`columns`] order: the `/telemetry` fields, then
-/// each effector's fields (shared by the tables and the Python package).
-pub fn fill_row(row: &mut Vec<f64>, sc: &Spacecraft, o: &Observation, y: &[f64], inv: &Reference) {
+/// each effector's fields, then with an `orbit` the attitude relative to LVLH (shared by the
+/// tables and the Python package).
+pub fn fill_row(
+    row: &mut Vec<f64>,
+    sc: &Spacecraft,
+    orbit: Option<&Orbit>,
+    o: &Observation,
+    y: &[f64],
+    inv: &Reference,
+) {
     row.clear();
     row.extend_from_slice(&telemetry::values(o, inv));
     let hub = HubState {
@@ -248,11 +272,14 @@ pub fn fill_row(row: &mut Vec<f64>, sc: &Spacecraft, o: &Observation, y: &[f64],
     for (k, e) in sc.effectors().iter().enumerate() {
         row.extend(e.telemetry(&hub, sc.effector_states(k, y)));
     }
+    if let Some(orbit) = orbit {
+        row.extend_from_slice(&orbit::attitude_values(orbit, o.t, &o.attitude, &o.omega));
+    }
 }
 
 impl Sink for SampleTable<'_> {
     fn sample(&mut self, o: &Observation, y: &[f64], inv: &Reference) -> io::Result<()> {
-        fill_row(&mut self.row, self.spacecraft, o, y, inv);
+        fill_row(&mut self.row, self.spacecraft, self.orbit, o, y, inv);
         if let Some((_, w)) = self.csv.as_mut() {
             use std::fmt::Write as _;
             self.text.clear();

@@ -137,7 +137,7 @@ const TELEMETRY_FIELDS: [(&str, &str, &str); 26] = [
 ];
 
 /// `/orbit`: field, description, unit.
-const ORBIT_FIELDS: [(&str, &str, &str); 16] = [
+const ORBIT_FIELDS: [(&str, &str, &str); 19] = [
     ("sim_time", "Simulation time since the epoch", "s"),
     ("r_eci_x", "Spacecraft position, ECI x", "km"),
     ("r_eci_y", "Spacecraft position, ECI y", "km"),
@@ -189,6 +189,21 @@ const ORBIT_FIELDS: [(&str, &str, &str); 16] = [
         "yaw_deg",
         "Yaw, 3-2-1 Euler angle about the LVLH o3 nadir axis, the first rotation, in (-180, 180]",
         "deg",
+    ),
+    (
+        "omega_lvlh_x",
+        "Body rate relative to LVLH, omega_BO = omega_BN - C_BN omega_ON, about body x",
+        "rad/s",
+    ),
+    (
+        "omega_lvlh_y",
+        "Body rate relative to LVLH, about body y",
+        "rad/s",
+    ),
+    (
+        "omega_lvlh_z",
+        "Body rate relative to LVLH, about body z",
+        "rad/s",
     ),
 ];
 

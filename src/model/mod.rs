@@ -505,6 +505,8 @@ impl std::fmt::Display for AddEffectorError {
     }
 }
 
+impl std::error::Error for AddEffectorError {}
+
 /// Several effectors coupled in one call, in place of their own [`Effector::couple`] (the
 /// scene's flap–lag rods, lane by lane: [`crate::effectors::rod_lanes`]). Used when no
 /// tidal field acts on the moving masses; the members' `couple` serves otherwise.

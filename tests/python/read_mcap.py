@@ -136,6 +136,7 @@ ORBIT_FIELDS = (
     "altitude", "argument_of_latitude_deg",
     "q_lvlh_w", "q_lvlh_x", "q_lvlh_y", "q_lvlh_z",
     "roll_deg", "pitch_deg", "yaw_deg",
+    "omega_lvlh_x", "omega_lvlh_y", "omega_lvlh_z",
 )
 ORBIT_Q_TOL = 1e-9
 ORBIT_POS_TOL = 1e-9  # relative, orbit-view positions against /orbit

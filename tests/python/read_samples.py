@@ -4,10 +4,12 @@
 Usage:
     read_samples.py LOG.mcap TABLE.csv TABLE.parquet
 
-Reads the log with the Foxglove `mcap` package and decodes every /telemetry and
-/effectors/<name> message from the schemas embedded in the file (no code from the
-Rust side), builds one row per /telemetry sample (its fields, then each effector's
-fields as `<effector>.<field>`, effectors in channel order), and checks that:
+Reads the log with the Foxglove `mcap` package and decodes every /telemetry,
+/effectors/<name> and /orbit message from the schemas embedded in the file (no code
+from the Rust side), builds one row per /telemetry sample (its fields, then each
+effector's fields as `<effector>.<field>`, effectors in channel order, then, when the
+log has an /orbit channel, its attitude relative to LVLH: the fields LVLH_FIELDS under
+their own names), and checks that:
   - the CSV, read with Python's csv module, has the same rows, bit for bit
     (float(text) == the decoded double), and its header names are the columns
     with their units as `name [unit]`, the units being the MCAP channels' `units`
@@ -34,6 +36,14 @@ except ImportError as e:  # pragma: no cover
     sys.exit(2)
 
 
+# The /orbit fields the tables carry for a scenario with an orbit (docs/logs.md).
+LVLH_FIELDS = (
+    "q_lvlh_w", "q_lvlh_x", "q_lvlh_y", "q_lvlh_z",
+    "roll_deg", "pitch_deg", "yaw_deg",
+    "omega_lvlh_x", "omega_lvlh_y", "omega_lvlh_z",
+)
+
+
 def fail(message: str) -> None:
     print(f"read_samples: FAIL: {message}", file=sys.stderr)
     sys.exit(1)
@@ -47,6 +57,7 @@ def from_log(path: str):
         channels = sorted(summary.channels.values(), key=lambda c: c.id)
         telemetry = [c for c in channels if c.topic == "/telemetry"][0]
         effectors = [c for c in channels if c.topic.startswith("/effectors/")]
+        orbit = [c for c in channels if c.topic == "/orbit"]
         columns: list[tuple[str, str]] = []
         for channel, prefix in [(telemetry, "")] + [
             (c, c.topic[len("/effectors/"):] + ".") for c in effectors
@@ -56,11 +67,17 @@ def from_log(path: str):
                 if prefix and name == "sim_time":
                     continue
                 columns.append((prefix + name, unit))
+        for channel in orbit:
+            units = json.loads(channel.metadata["units"])
+            columns.extend((name, units[name]) for name in LVLH_FIELDS)
         samples: dict[int, list[float]] = {}
-        extra: dict[str, dict[int, list[float]]] = {c.topic: {} for c in effectors}
+        extra: dict[str, dict[int, list[float]]] = {c.topic: {} for c in effectors + orbit}
         for _, channel, message, decoded in reader.iter_decoded_messages(
-            topics=["/telemetry"] + [c.topic for c in effectors]
+            topics=["/telemetry"] + [c.topic for c in effectors + orbit]
         ):
+            if channel.topic == "/orbit":
+                extra["/orbit"][message.log_time] = [getattr(decoded, n) for n in LVLH_FIELDS]
+                continue
             values = [getattr(decoded, f.name) for f in decoded.DESCRIPTOR.fields]
             if channel.topic == "/telemetry":
                 samples[message.log_time] = values
@@ -69,7 +86,7 @@ def from_log(path: str):
     rows = []
     for log_time in sorted(samples):
         row = list(samples[log_time])
-        for c in effectors:
+        for c in effectors + orbit:
             row.extend(extra[c.topic][log_time])
         rows.append(row)
     return columns, rows
