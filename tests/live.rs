@@ -4,7 +4,8 @@
 //! id and log time in little-endian) subscribes to `/tf` and `/telemetry` of a paced run and
 //! checks what arrives: the schemas the MCAP log names, messages that decode (a unit quaternion
 //! turning `body` in `world`; |H| held by a run that only dissipates energy), byte for byte the
-//! messages of the MCAP written by the same run, and sim time going no faster than asked.
+//! messages of the MCAP written by the same run, the clock (opcode 2) at each message's log
+//! time before it, and sim time going no faster than asked.
 
 use foxglove::messages::FrameTransforms;
 use prost::Message as _;
@@ -80,6 +81,8 @@ struct Seen {
     encoding: String,
     /// (log time in ns, payload, wall-clock instant of arrival)
     messages: Vec<(u64, Vec<u8>, Instant)>,
+    /// For each message, the clock the server had sent before it (ns; 0 if none).
+    clock_before: Vec<u64>,
 }
 
 /// Connects to the live view on `port`, subscribes to `topics` and collects until each has
@@ -104,6 +107,8 @@ fn watch(port: u16, topics: &[&str], count: usize) -> BTreeMap<String, Seen> {
     let mut seen: BTreeMap<String, Seen> = BTreeMap::new();
     // Subscription id → topic.
     let mut subscribed: BTreeMap<u32, String> = BTreeMap::new();
+    // The server's clock (the `time` capability: binary opcode 2).
+    let mut clock = 0u64;
     let deadline = Instant::now() + PATIENCE;
     while topics
         .iter()
@@ -148,6 +153,7 @@ fn watch(port: u16, topics: &[&str], count: usize) -> BTreeMap<String, Seen> {
                             schema_name: channel["schemaName"].as_str().unwrap().to_string(),
                             encoding: channel["encoding"].as_str().unwrap().to_string(),
                             messages: Vec::new(),
+                            clock_before: Vec::new(),
                         },
                     );
                     subscriptions.push(serde_json::json!({"id": id, "channelId": channel["id"]}));
@@ -160,7 +166,13 @@ fn watch(port: u16, topics: &[&str], count: usize) -> BTreeMap<String, Seen> {
                 }
             }
             Message::Binary(frame) => {
-                // Opcode 1: message data.
+                // Opcode 2: time; opcode 1: message data.
+                if frame.first() == Some(&2) {
+                    let time = u64::from_le_bytes(frame[1..9].try_into().unwrap());
+                    assert!(time >= clock, "the clock went back from {clock} to {time}");
+                    clock = time;
+                    continue;
+                }
                 if frame.first() != Some(&1) {
                     continue;
                 }
@@ -170,6 +182,7 @@ fn watch(port: u16, topics: &[&str], count: usize) -> BTreeMap<String, Seen> {
                 let s = seen.get_mut(topic).unwrap();
                 s.messages
                     .push((log_time, frame[13..].to_vec(), Instant::now()));
+                s.clock_before.push(clock);
             }
             _ => {}
         }
@@ -228,6 +241,15 @@ fn a_client_receives_tf_and_telemetry_as_the_run_computes() {
 
     let tf = &seen["/tf"];
     let telemetry = &seen["/telemetry"];
+    // Each sample's time comes before its messages, so a viewer stamps them with sim time.
+    for s in [tf, telemetry] {
+        for ((log_time, _, _), clock) in s.messages.iter().zip(&s.clock_before) {
+            assert_eq!(
+                clock, log_time,
+                "message at {log_time} after the clock {clock}"
+            );
+        }
+    }
     // The schema names of docs/logs.md, as in the MCAP.
     assert_eq!(tf.schema_name, "foxglove.FrameTransforms");
     assert_eq!(telemetry.schema_name, "polhode.Telemetry");

@@ -10,7 +10,9 @@
 //! app; the two are the same protocol under two names, and the server accepts either (the
 //! `foxglove` crate's own server accepts only the second, which Foxglove Studio does not
 //! offer). Only what a viewer of a log needs is served: `serverInfo`, `advertise`,
-//! `subscribe`, `unsubscribe` and binary message data (opcode 1).
+//! `subscribe`, `unsubscribe`, binary message data (opcode 1) and the `time` capability: the
+//! log time of each new sample (opcode 2) before its messages, so that a viewer stamps what it
+//! receives with sim time, not with its arrival.
 //!
 //! A viewer that connects late misses what was sent before it subscribed; the one message
 //! sent only once, the Earth of the orbit view (`/earth`), is kept and sent again to each new
@@ -64,6 +66,8 @@ struct Shared {
     clients: Mutex<Vec<Arc<Viewer>>>,
     /// The last message of each latched channel: log time and bytes.
     latched: Mutex<HashMap<u32, (u64, Vec<u8>)>>,
+    /// The latest log time published (ns), sent as the clock.
+    clock: Mutex<u64>,
     stop: AtomicBool,
 }
 
@@ -159,7 +163,16 @@ impl LiveServer {
         if latched {
             lock(&self.shared.latched).insert(id, (log_time, data.to_vec()));
         }
+        let tick = {
+            let mut clock = lock(&self.shared.clock);
+            let later = log_time > *clock;
+            *clock = (*clock).max(log_time);
+            later
+        };
         for viewer in lock(&self.shared.clients).iter() {
+            if tick {
+                let _ = viewer.queue.try_send(time_frame(log_time));
+            }
             let subscription = lock(&viewer.subscriptions).get(&id).copied();
             if let Some(subscription) = subscription {
                 let _ = viewer
@@ -191,6 +204,14 @@ fn message_data(subscription: u32, log_time: u64, data: &[u8]) -> Message {
     frame.extend_from_slice(&subscription.to_le_bytes());
     frame.extend_from_slice(&log_time.to_le_bytes());
     frame.extend_from_slice(data);
+    Message::binary(frame)
+}
+
+/// A binary time frame: opcode 2, the log time (ns) the viewer's clock is at.
+fn time_frame(log_time: u64) -> Message {
+    let mut frame = Vec::with_capacity(9);
+    frame.push(2);
+    frame.extend_from_slice(&log_time.to_le_bytes());
     Message::binary(frame)
 }
 
@@ -296,7 +317,7 @@ fn serve(stream: TcpStream, shared: &Arc<Shared>) {
     let hello = json!({
         "op": "serverInfo",
         "name": format!("polhode {}", env!("CARGO_PKG_VERSION")),
-        "capabilities": [],
+        "capabilities": ["time"],
         "supportedEncodings": [],
         "metadata": {},
         "sessionId": format!("{}", std::process::id()),
