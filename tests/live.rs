@@ -1,4 +1,4 @@
-//! The live view (`polhode run --live`, docs/viewing.md#live): a plain WebSocket client
+//! The live view (`polhode run --live`, docs/viewing.md#live-view): a plain WebSocket client
 //! speaking the Foxglove WebSocket protocol (subprotocol `foxglove.websocket.v1`: the server's
 //! `advertise`, the client's `subscribe`, binary message-data frames of opcode 1, subscription
 //! id and log time in little-endian) subscribes to `/tf` and `/telemetry` of a paced run and
