@@ -52,6 +52,20 @@ pub(super) enum Command {
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,
+        /// Serve the run as it computes to Foxglove over its WebSocket protocol
+        /// (ws://localhost:8765 unless --port), the same topics as the log (docs/viewing.md).
+        #[arg(long)]
+        live: bool,
+        /// Port of the live view (0: any free port, printed on stderr).
+        #[arg(long, requires = "live", default_value_t = crate::log::live::DEFAULT_PORT)]
+        port: u16,
+        /// Pace the run at X times wall-clock time (X s of sim time per second); without it
+        /// a live run goes at full speed.
+        #[arg(long, value_name = "X", requires = "live")]
+        realtime: Option<f64>,
+        /// Seconds the live view stays up after the run ends (default: until Ctrl-C).
+        #[arg(long, value_name = "S", requires = "live")]
+        live_linger: Option<f64>,
     },
     /// Validate a scenario and exit.
     Check {

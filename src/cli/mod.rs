@@ -141,6 +141,10 @@ pub fn main() -> i32 {
             parquet,
             max_log_mb,
             quiet,
+            live,
+            port,
+            realtime,
+            live_linger,
         } => {
             let overrides = Overrides {
                 max_log_mb,
@@ -151,6 +155,11 @@ pub fn main() -> i32 {
                 summary: summary.as_deref(),
                 csv: csv.as_deref(),
                 parquet: parquet.as_deref(),
+                live: live.then_some(run::LiveOptions {
+                    port,
+                    realtime,
+                    linger: live_linger,
+                }),
             };
             run::run(&scenario, &overrides, &outputs, quiet)
         }

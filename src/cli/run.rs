@@ -2,13 +2,16 @@
 
 use super::summary::{print_summary, summary_json};
 use super::{EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_IO, load, probe_writable};
+use crate::log::live::LiveServer;
+use crate::log::pacing::Pacing;
 use crate::log::{McapLogger, write_atomically};
 use crate::scenario::Overrides;
-use crate::sim::{self, Control, NullSink, Status};
+use crate::sim::{self, Control, NullSink, Sink, Status};
 use std::io::IsTerminal;
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 /// What `polhode run` writes besides its text.
 pub(super) struct RunOutputs<'a> {
@@ -20,6 +23,18 @@ pub(super) struct RunOutputs<'a> {
     pub(super) csv: Option<&'a Path>,
     /// The sampled telemetry as Parquet.
     pub(super) parquet: Option<&'a Path>,
+    /// The live view (`--live`), if asked for.
+    pub(super) live: Option<LiveOptions>,
+}
+
+/// `--live` and its options.
+pub(super) struct LiveOptions {
+    /// Port to serve on (0: any free port).
+    pub(super) port: u16,
+    /// `--realtime X`: X seconds of sim time per wall-clock second; none: full speed.
+    pub(super) realtime: Option<f64>,
+    /// `--live-linger S`: seconds the server stays up after the run; none: until Ctrl-C.
+    pub(super) linger: Option<f64>,
 }
 
 /// Runs the scenario at `path` with `overrides`, writing `outputs`; returns the exit code.
@@ -55,6 +70,38 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
         eprintln!("error: cannot write the summary to {}: {e}", p.display());
         return EXIT_BAD_INPUT;
     }
+    if let Some(live) = &outputs.live {
+        for (flag, value, least) in [
+            ("--realtime", live.realtime, "greater than 0"),
+            ("--live-linger", live.linger, "0 or more"),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && (v > 0.0 || (v == 0.0 && flag == "--live-linger")))
+            {
+                eprintln!("error: {flag} {v}: expected a finite number of seconds {least}");
+                return EXIT_BAD_INPUT;
+            }
+        }
+    }
+    // The server first: a port that cannot be bound stops the run before any file is made.
+    let server = match &outputs.live {
+        Some(live) => match LiveServer::start(live.port) {
+            Ok(server) => {
+                if !quiet {
+                    eprintln!(
+                        "live view: {} (Foxglove: Open connection → Foxglove WebSocket)",
+                        server.url()
+                    );
+                }
+                Some(Arc::new(server))
+            }
+            Err(e) => {
+                eprintln!("error: {e}; choose another port with --port");
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
     let mut table = if outputs.csv.is_some() || outputs.parquet.is_some() {
         match crate::log::samples::SampleTable::create(
             &s.spacecraft,
@@ -80,10 +127,11 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
     } else {
         None
     };
-    let mut logger = if no_log {
+    let mut logger = if no_log && server.is_none() {
         None
     } else {
-        match McapLogger::create(&s.mcap_path, &s, s.omega0.norm()) {
+        let file = (!no_log).then_some(s.mcap_path.as_path());
+        match McapLogger::create_with_live(file, server.clone(), &s, s.omega0.norm()) {
             Ok(l) => Some(l),
             Err(e) => {
                 eprintln!(
@@ -94,7 +142,7 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
             }
         }
     };
-    if let Some(l) = logger.as_mut() {
+    if let Some(l) = logger.as_mut().filter(|l| l.final_path().is_some()) {
         let estimate_mb = l.estimate_bytes(&s) / 1e6;
         if estimate_mb > s.max_log_mb {
             eprintln!(
@@ -150,11 +198,22 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
         interrupt: &interrupt,
         progress: Some(&mut progress),
     };
-    let result = match (logger.as_mut(), table.as_mut()) {
-        (Some(l), Some(t)) => sim::run(&s, &mut crate::log::samples::Both(l, t), ctl),
-        (Some(l), None) => sim::run(&s, l, ctl),
-        (None, Some(t)) => sim::run(&s, t, ctl),
-        (None, None) => sim::run(&s, &mut NullSink, ctl),
+    let (mut both, mut null);
+    let sink: &mut dyn Sink = match (logger.as_mut(), table.as_mut()) {
+        (Some(l), Some(t)) => {
+            both = crate::log::samples::Both(l, t);
+            &mut both
+        }
+        (Some(l), None) => l,
+        (None, Some(t)) => t,
+        (None, None) => {
+            null = NullSink;
+            &mut null
+        }
+    };
+    let result = match outputs.live.as_ref().and_then(|l| l.realtime) {
+        Some(speed) => sim::run(&s, &mut Pacing::new(sink, speed), ctl),
+        None => sim::run(&s, sink, ctl),
     };
     if let Some(b) = &bar {
         b.finish_and_clear();
@@ -208,6 +267,12 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
         }
     }
     let mut written = None;
+    if let Some(mut l) = logger.take_if(|l| l.final_path().is_none()) {
+        // A live view alone: it only gets the run's end on `/log`.
+        if let Err(e) = l.end_run(&outcome) {
+            eprintln!("warning: the live view did not get the run's end: {e}");
+        }
+    }
     if let Some(l) = logger {
         match l.finish(&s, &s.method.describe(), &outcome) {
             Ok(p) => written = Some(p),
@@ -236,6 +301,11 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
     for w in &outcome.warnings {
         eprintln!("warning: {}", w.message);
     }
+    if let (Some(server), Some(live)) = (server, &outputs.live)
+        && !matches!(outcome.status, Status::Interrupted)
+    {
+        linger(server, live.linger, &interrupt, quiet);
+    }
     match &outcome.status {
         Status::Complete | Status::Stopped { .. } => 0,
         Status::Interrupted => {
@@ -253,5 +323,31 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
             eprintln!("error: the model left its validity range: {diagnosis}");
             EXIT_FAILED
         }
+    }
+}
+
+/// Keeps the live view up after the run, so that a viewer can look back over it: for
+/// `seconds`, or until Ctrl-C when none; then stops the server.
+fn linger(server: Arc<LiveServer>, seconds: Option<f64>, interrupt: &AtomicBool, quiet: bool) {
+    if !quiet {
+        match seconds {
+            Some(t) if t > 0.0 => eprintln!(
+                "the run is over; the live view stays up at {} for {t} s (Ctrl-C ends it)",
+                server.url()
+            ),
+            Some(_) => {}
+            None => eprintln!(
+                "the run is over; the live view stays up at {} until Ctrl-C",
+                server.url()
+            ),
+        }
+    }
+    let end = seconds.map(|t| Instant::now() + Duration::from_secs_f64(t));
+    while !interrupt.load(Ordering::SeqCst) && end.is_none_or(|end| Instant::now() < end) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // The log, the only other holder, is finished by now.
+    if let Ok(server) = Arc::try_unwrap(server) {
+        server.stop();
     }
 }

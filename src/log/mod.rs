@@ -13,8 +13,11 @@
 //! target directory and renamed when finished, so a final name never holds a half-written log.
 
 pub mod charts;
+pub mod live;
 pub mod orbit;
 pub mod orbit_scene;
+mod outlets;
+pub mod pacing;
 pub mod samples;
 pub mod telemetry;
 pub mod units;
@@ -23,12 +26,13 @@ use crate::model::{Drawing, HubState, Observation, Spacecraft};
 use crate::scenario::{Compression, Scenario, Shape, format_epoch, log_origin};
 use crate::sim::{EventRecord, Outcome, Reference, Sink};
 use foxglove::Encode;
+use foxglove::Schema;
 use foxglove::messages as fg;
-use mcap::records::MessageHeader;
+use live::LiveServer;
 use nalgebra::{UnitQuaternion, Vector3};
+use outlets::Outlets;
 use std::borrow::Cow;
 use std::collections::BTreeMap;
-use std::fs::File;
 use std::io::{self, BufWriter};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -56,9 +60,10 @@ pub struct McapLogger<'a> {
     spacecraft: &'a Spacecraft,
     /// `/effectors/<name>` channel of each effector, in order.
     effector_channels: Vec<u16>,
-    writer: mcap::Writer<BufWriter<File>>,
-    temp: TempFile,
-    final_path: PathBuf,
+    /// The file and the live view the messages go to.
+    outlets: Outlets,
+    /// The file's temporary name and its final one (none for a live view alone).
+    file: Option<(TempFile, PathBuf)>,
     epoch_ns: u64,
     channels: Channels,
     sequence: u32,
@@ -168,7 +173,7 @@ fn orbit_view(scenario: &Scenario, prefix: &str) -> Option<orbit_scene::OrbitSce
 
 /// Adds the schemas and channels of one run under `prefix`.
 fn register(
-    writer: &mut mcap::Writer<BufWriter<File>>,
+    writer: &mut Outlets,
     registry: &mut Registry,
     scenario: &Scenario,
     prefix: &str,
@@ -177,13 +182,10 @@ fn register(
     let tf = add::<fg::FrameTransforms>(writer, &format!("{prefix}/tf"))?;
     let scene = add::<fg::SceneUpdate>(writer, &format!("{prefix}/scene"))?;
     let schema = telemetry::schema_bytes();
-    let tid = writer
-        .add_schema(telemetry::SCHEMA_NAME, "protobuf", &schema)
-        .map_err(io_err)?;
     let telemetry = add_channel(
         writer,
         registry,
-        tid,
+        Schema::new(telemetry::SCHEMA_NAME, "protobuf", schema),
         format!("{prefix}/telemetry"),
         BTreeMap::from([(
             "units".to_string(),
@@ -203,13 +205,10 @@ fn register(
             registry.effector_schemas.insert(message, names.clone());
         }
         // Identical schemas (same name and fields) are written once and shared.
-        let id = writer
-            .add_schema(&name, "protobuf", &schema)
-            .map_err(io_err)?;
         effector_channels.push(add_channel(
             writer,
             registry,
-            id,
+            Schema::new(name, "protobuf", schema),
             format!("{prefix}/effectors/{}", e.name()),
             BTreeMap::from([
                 ("kind".to_string(), e.kind().to_string()),
@@ -223,7 +222,12 @@ fn register(
     // Only for a scenario with an orbit: a scenario without one writes the same file as before.
     let (earth, orbit_scene) = match &scenario.orbit {
         Some(_) => (
-            Some(add::<fg::SceneUpdate>(writer, &format!("{prefix}/earth"))?),
+            // Written once, at the first sample: kept for viewers that join a live run later.
+            Some(add_latched::<fg::SceneUpdate>(
+                writer,
+                &format!("{prefix}/earth"),
+                true,
+            )?),
             Some(add::<fg::SceneUpdate>(
                 writer,
                 &format!("{prefix}/orbit_scene"),
@@ -235,13 +239,10 @@ fn register(
         Some(_) => {
             let schema = orbit::schema_bytes();
             registry.bytes += orbit::SCHEMA_NAME.len() + schema.len();
-            let id = writer
-                .add_schema(orbit::SCHEMA_NAME, "protobuf", &schema)
-                .map_err(io_err)?;
             Some(add_channel(
                 writer,
                 registry,
-                id,
+                Schema::new(orbit::SCHEMA_NAME, "protobuf", schema),
                 format!("{prefix}/orbit"),
                 BTreeMap::from([(
                     "units".to_string(),
@@ -267,9 +268,9 @@ fn register(
 
 /// Adds a protobuf channel, counting its topic and metadata in `registry`.
 fn add_channel(
-    writer: &mut mcap::Writer<BufWriter<File>>,
+    writer: &mut Outlets,
     registry: &mut Registry,
-    schema: u16,
+    schema: Schema,
     topic: String,
     metadata: BTreeMap<String, String>,
 ) -> io::Result<u16> {
@@ -278,9 +279,7 @@ fn add_channel(
             .iter()
             .map(|(k, v)| k.len() + v.len())
             .sum::<usize>();
-    writer
-        .add_channel(schema, &topic, "protobuf", &metadata)
-        .map_err(io_err)
+    writer.add_channel(&topic, &schema, "protobuf", &metadata, false)
 }
 
 /// The message name of the schema for an effector of `kind` with `fields`: that of
@@ -310,13 +309,20 @@ fn io_err(e: mcap::McapError) -> io::Error {
     }
 }
 
-fn add<T: Encode>(w: &mut mcap::Writer<BufWriter<File>>, topic: &str) -> io::Result<u16> {
+fn add<T: Encode>(w: &mut Outlets, topic: &str) -> io::Result<u16> {
+    add_latched::<T>(w, topic, false)
+}
+
+/// Adds a channel of Foxglove messages `T`; `latched`: see [`Outlets::add_channel`].
+fn add_latched<T: Encode>(w: &mut Outlets, topic: &str, latched: bool) -> io::Result<u16> {
     let schema = T::get_schema().ok_or_else(|| io::Error::other("message without schema"))?;
-    let id = w
-        .add_schema(&schema.name, &schema.encoding, &schema.data)
-        .map_err(io_err)?;
-    w.add_channel(id, topic, &T::get_message_encoding(), &BTreeMap::new())
-        .map_err(io_err)
+    w.add_channel(
+        topic,
+        &schema,
+        &T::get_message_encoding(),
+        &BTreeMap::new(),
+        latched,
+    )
 }
 
 impl<'a> McapLogger<'a> {
@@ -324,6 +330,30 @@ impl<'a> McapLogger<'a> {
     /// channels. Fails before any integration if the location is not writable.
     pub fn create(path: &Path, scenario: &'a Scenario, outcome_ref_omega: f64) -> io::Result<Self> {
         Self::create_prefixed(path, scenario, outcome_ref_omega, "")
+    }
+
+    /// A log of one run to the file `path` (if any) and to the live view `live` (if any):
+    /// the same channels and messages in both. With neither, the messages go nowhere.
+    pub fn create_with_live(
+        path: Option<&Path>,
+        live: Option<Arc<LiveServer>>,
+        scenario: &'a Scenario,
+        outcome_ref_omega: f64,
+    ) -> io::Result<Self> {
+        let (file, writer) = match path {
+            Some(p) => {
+                let (temp, writer) = Self::open_file(p, scenario)?;
+                (Some((temp, p.to_path_buf())), Some(writer))
+            }
+            None => (None, None),
+        };
+        Self::with_outlets(
+            Outlets::new(writer, live),
+            file,
+            scenario,
+            outcome_ref_omega,
+            "",
+        )
     }
 
     /// As [`McapLogger::create`], with every topic under `prefix` (e.g. `/worst`) and the
@@ -335,6 +365,18 @@ impl<'a> McapLogger<'a> {
         outcome_ref_omega: f64,
         prefix: &str,
     ) -> io::Result<Self> {
+        let (temp, writer) = Self::open_file(path, scenario)?;
+        Self::with_outlets(
+            Outlets::new(Some(writer), None),
+            Some((temp, path.to_path_buf())),
+            scenario,
+            outcome_ref_omega,
+            prefix,
+        )
+    }
+
+    /// Creates the temporary file beside `path` and its MCAP writer (the header).
+    fn open_file(path: &Path, scenario: &Scenario) -> io::Result<(TempFile, outlets::FileWriter)> {
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -357,17 +399,28 @@ impl<'a> McapLogger<'a> {
             .compression_threads(0)
             .profile("")
             .library(format!("polhode {}", env!("CARGO_PKG_VERSION")));
-        let mut writer = options
+        let writer = options
             .create(BufWriter::with_capacity(1 << 16, file))
             .map_err(io_err)?;
+        Ok((temp, writer))
+    }
+
+    /// Registers the channels of one run under `prefix` in `outlets`.
+    fn with_outlets(
+        mut outlets: Outlets,
+        file: Option<(TempFile, PathBuf)>,
+        scenario: &'a Scenario,
+        outcome_ref_omega: f64,
+        prefix: &str,
+    ) -> io::Result<Self> {
         let mut registry = Registry::default();
-        let (channels, effector_channels) = register(&mut writer, &mut registry, scenario, prefix)?;
+        let (channels, effector_channels) =
+            register(&mut outlets, &mut registry, scenario, prefix)?;
         Ok(McapLogger {
             spacecraft: &scenario.spacecraft,
             effector_channels,
-            writer,
-            temp,
-            final_path: path.to_path_buf(),
+            outlets,
+            file,
             epoch_ns: log_origin(scenario.epoch_unix_ns),
             channels,
             sequence: 0,
@@ -390,21 +443,20 @@ impl<'a> McapLogger<'a> {
         prefix: &str,
     ) -> io::Result<McapLogger<'b>> {
         let McapLogger {
-            mut writer,
-            temp,
-            final_path,
+            mut outlets,
+            file,
             sequence,
             mut registry,
             buf,
             ..
         } = self;
-        let (channels, effector_channels) = register(&mut writer, &mut registry, scenario, prefix)?;
+        let (channels, effector_channels) =
+            register(&mut outlets, &mut registry, scenario, prefix)?;
         Ok(McapLogger {
             spacecraft: &scenario.spacecraft,
             effector_channels,
-            writer,
-            temp,
-            final_path,
+            outlets,
+            file,
             epoch_ns: log_origin(scenario.epoch_unix_ns),
             channels,
             sequence,
@@ -418,9 +470,9 @@ impl<'a> McapLogger<'a> {
         })
     }
 
-    /// Where the finished log will be.
-    pub fn final_path(&self) -> &Path {
-        &self.final_path
+    /// Where the finished log will be (none for a live view alone).
+    pub fn final_path(&self) -> Option<&Path> {
+        self.file.as_ref().map(|(_, p)| p.as_path())
     }
 
     /// Log time (Unix ns) of sim time `t`, from the log origin (the epoch, or 1970-01-01 for
@@ -438,15 +490,8 @@ impl<'a> McapLogger<'a> {
 
     fn write_raw(&mut self, channel: u16, log_time: u64) -> io::Result<()> {
         self.sequence = self.sequence.wrapping_add(1);
-        let header = MessageHeader {
-            channel_id: channel,
-            sequence: self.sequence,
-            log_time,
-            publish_time: log_time,
-        };
-        self.writer
-            .write_to_known_channel(&header, &self.buf)
-            .map_err(io_err)
+        self.outlets
+            .write(channel, self.sequence, log_time, &self.buf)
     }
 
     fn write<T: Encode>(&mut self, channel: u16, t: f64, msg: &T) -> io::Result<()> {
@@ -470,7 +515,8 @@ impl<'a> McapLogger<'a> {
     }
 
     /// Writes the run's end to `/log`, its metadata and the scenario attachment, finishes the
-    /// file and renames it to its final name.
+    /// file and renames it to its final name, which it returns. A log without a file (a live
+    /// view alone) takes [`McapLogger::end_run`] instead.
     pub fn finish(
         mut self,
         scenario: &Scenario,
@@ -566,29 +612,32 @@ impl<'a> McapLogger<'a> {
         metadata: BTreeMap<String, String>,
         attachments: Vec<Attachment>,
     ) -> io::Result<PathBuf> {
-        self.writer
+        let epoch_ns = self.epoch_ns;
+        let writer = self
+            .outlets
+            .file_mut()
+            .ok_or_else(|| io::Error::other("this log has no file to finish"))?;
+        writer
             .write_metadata(&mcap::records::Metadata {
                 name: name.into(),
                 metadata,
             })
             .map_err(io_err)?;
         for a in attachments {
-            self.writer
+            writer
                 .attach(&mcap::Attachment {
-                    log_time: self.epoch_ns,
-                    create_time: self.epoch_ns,
+                    log_time: epoch_ns,
+                    create_time: epoch_ns,
                     name: a.name,
                     media_type: a.media_type,
                     data: Cow::Owned(a.data),
                 })
                 .map_err(io_err)?;
         }
-        let McapLogger {
-            mut writer,
-            temp,
-            final_path,
-            ..
-        } = self;
+        let McapLogger { outlets, file, .. } = self;
+        let (Some(mut writer), Some((temp, final_path))) = (outlets.into_file(), file) else {
+            return Err(io::Error::other("this log has no file to finish"));
+        };
         writer.finish().map_err(io_err)?;
         let file = writer
             .into_inner()

@@ -92,7 +92,12 @@ async function main() {
       hideSignInPrompt: true,
     }),
     layoutStorage: memoryLayoutStorage([layout]),
-    dataSources: [new window.RemoteDataSourceFactory(), new window.McapLocalDataSourceFactory()],
+    // A log file (ds=remote-file), or a live run (ds=foxglove-websocket, `polhode run --live`).
+    dataSources: [
+      new window.RemoteDataSourceFactory(),
+      new window.McapLocalDataSourceFactory(),
+      new window.FoxgloveWebSocketDataSourceFactory(),
+    ],
     extensionLoaders: [],
     enableLaunchPreferenceScreen: false,
   });

@@ -4,7 +4,10 @@
 # them. Installs what is missing (Debian's chromium, the npm packages of this folder), makes
 # the explorer1-pydy log, and writes $OUT/foxglove-early.png and $OUT/foxglove-late.png; then
 # the same with a scenario in orbit (the orbit panel: Earth, path, marker), written to
-# $OUT/foxglove-orbit-early.png and $OUT/foxglove-orbit-late.png.
+# $OUT/foxglove-orbit-early.png and $OUT/foxglove-orbit-late.png. Last, the live view:
+# `polhode run --live` of explorer1-pydy paced at LIVE_REALTIME times wall-clock time
+# (default 2) on a free port, Foxglove connected to it (ds=foxglove-websocket) with the same
+# layout, one screenshot $OUT/foxglove-live.png once the body and every series are drawn.
 #
 #   scripts/viewers/foxglove/run.sh
 #
@@ -136,10 +139,34 @@ node "$here/screenshots.mjs" --log "$log" --out "$out" --chromium "$chromium" \
   --early "${EARLY:-10}" --late "${LATE:-120}" || status=$?
 node "$here/screenshots.mjs" --log "$orbit_log" --out "$out" --chromium "$chromium" --orbit \
   --early "${ORBIT_EARLY:-2000}" --late "${ORBIT_LATE:-3400}" || status=$?
+
+# The live view: the run serves on a free port (--port 0) and says which on stderr; it stays
+# up after the run (no --live-linger) until it is stopped here.
+"$polhode" run "$scenario" --no-log --live --port 0 --realtime "${LIVE_REALTIME:-2}" \
+  </dev/null >"$work/polhode-live.txt" 2>"$work/polhode-live.err" &
+live_pid=$!
+live_url=""
+for _ in $(seq 1 300); do
+  live_url=$(grep -o 'ws://localhost:[0-9]*' "$work/polhode-live.err" | head -n 1 || true)
+  [ -n "$live_url" ] || ! kill -0 "$live_pid" 2>/dev/null && break
+  sleep 0.1
+done
+if [ -z "$live_url" ]; then
+  cat "$work/polhode-live.err" >&2
+  echo "FAIL: polhode run --live did not announce its address" >&2
+  status=1
+else
+  echo "live: $live_url (polhode pid $live_pid)"
+  # The page is served from 127.0.0.1 and reaches nothing else.
+  node "$here/screenshots.mjs" --live "${live_url/localhost/127.0.0.1}" --out "$out" \
+    --chromium "$chromium" --timeout 150 || status=$?
+fi
+kill "$live_pid" 2>/dev/null || true
+wait "$live_pid" 2>/dev/null || true
 echo "screenshots: $(since "$t_shots") s"
 if [ "$status" -eq 0 ]; then
   echo "PASS (foxglove): $out/foxglove-early.png, $out/foxglove-late.png," \
-    "$out/foxglove-orbit-early.png, $out/foxglove-orbit-late.png"
+    "$out/foxglove-orbit-early.png, $out/foxglove-orbit-late.png, $out/foxglove-live.png"
 else
   echo "FAIL (foxglove)"
 fi

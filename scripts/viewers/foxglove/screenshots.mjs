@@ -9,8 +9,15 @@
 // pixels of the effectors' red (a rotor or wheel disc, seen through the translucent body) at
 // both times. Exits 1 with a message when a check fails.
 //
+// With --live URL instead of --log: Foxglove connects to a live run (`polhode run --live`,
+// ds=foxglove-websocket) and takes one screenshot, NAME-live.png (NAME defaults to
+// foxglove), as soon as the body and every plotted series are drawn (a live page never
+// settles: new samples keep coming), or at --timeout; it is checked as one of the two above
+// (the 3D panel not blank, the body drawn, every plotted series drawn).
+//
 //   node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S] [--orbit]
 //                        [--name NAME] [--effectors N] [--chromium PATH] [--timeout S]
+//   node screenshots.mjs --live ws://127.0.0.1:PORT [--out DIR] [--name NAME] [--timeout S]
 //
 // --early and --late are seconds after the log's first message (default 10 and 120).
 // Screenshots: DIR/NAME-early.png and DIR/NAME-late.png (NAME defaults to foxglove, or
@@ -196,7 +203,8 @@ function hexColour(hex) {
 }
 
 // Open the log at `time` and return the settled screenshot and the panel regions.
-async function capture(browser, pageUrl, panels, timeoutMs, analysis) {
+// `ready(png, regions)`, if given, ends the wait instead of the page settling (a live view).
+async function capture(browser, pageUrl, panels, timeoutMs, analysis, ready) {
   const context = await browser.newContext({ viewport: { width: 1600, height: 900 }, deviceScaleFactor: 1 });
   // Close the sidebars and skip the settings tooltip, so the panels fill the window.
   await context.addInitScript(() => {
@@ -268,7 +276,11 @@ async function capture(browser, pageUrl, panels, timeoutMs, analysis) {
     await page.waitForTimeout(1500);
     shots.push((await page.screenshot()).toString("base64"));
     shots = shots.slice(-3);
-    if (shots.length === 3 && Date.now() - started > 6000) {
+    if (ready) {
+      if (Date.now() - started > 6000 && (await ready(shots[shots.length - 1], regions))) {
+        break;
+      }
+    } else if (shots.length === 3 && Date.now() - started > 6000) {
       const d1 = await analysis.evaluate(([a, b, r, p]) => window.regionDiff(a, b, r, p), [shots[0], shots[1], whole, PIXEL_DIFFERENCE]);
       const d2 = await analysis.evaluate(([a, b, r, p]) => window.regionDiff(a, b, r, p), [shots[1], shots[2], whole, PIXEL_DIFFERENCE]);
       if (d1.fraction < 1e-4 && d2.fraction < 1e-4) {
@@ -293,6 +305,7 @@ async function main() {
   const { values: args } = parseArgs({
     options: {
       log: { type: "string" },
+      live: { type: "string" },
       out: { type: "string", default: join(REPO, "docs/figures/viewing") },
       early: { type: "string", default: "10" },
       late: { type: "string", default: "120" },
@@ -304,16 +317,18 @@ async function main() {
     },
   });
   const name = args.name ?? (args.orbit ? "foxglove-orbit" : "foxglove");
-  if (!args.log) {
-    fail("usage: node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S]");
+  if (!args.log === !args.live) {
+    fail("usage: node screenshots.mjs --log FILE.mcap [--out DIR] [--early S] [--late S], or --live ws://HOST:PORT");
   }
-  const logPath = resolve(args.log);
+  const live = args.live;
+  // A live run has no file: one screenshot, of whatever the connection brought.
+  const logPath = live ? undefined : resolve(args.log);
   const timeoutMs = Number(args.timeout) * 1000;
-  const { start, end } = await mcapTimeRange(logPath).catch((e) => fail(e.message));
+  const { start, end } = live ? { start: 0n, end: 0n } : await mcapTimeRange(logPath).catch((e) => fail(e.message));
   const spanS = Number(end - start) / 1e9;
-  const times = { early: Number(args.early), late: Number(args.late) };
+  const times = live ? { live: 0 } : { early: Number(args.early), late: Number(args.late) };
   for (const [name, t] of Object.entries(times)) {
-    if (!(t >= 0 && t <= spanS)) {
+    if (!live && !(t >= 0 && t <= spanS)) {
       fail(`--${name} ${t} s is outside the log (0 to ${spanS} s)`);
     }
   }
@@ -343,7 +358,7 @@ async function main() {
   // The log is on another origin, so expose the range headers Foxglove checks.
   const site = createServer({ root: REPO, cache: -1, showDir: false });
   const data = createServer({
-    root: dirname(logPath),
+    root: live ? HERE : dirname(logPath),
     cache: -1,
     showDir: false,
     cors: true,
@@ -351,7 +366,7 @@ async function main() {
   });
   const sitePort = await listen(site);
   const dataPort = await listen(data);
-  const logUrl = `http://127.0.0.1:${dataPort}/${encodeURIComponent(basename(logPath))}`;
+  const logUrl = live ? undefined : `http://127.0.0.1:${dataPort}/${encodeURIComponent(basename(logPath))}`;
 
   const browser = await chromium.launch({ executablePath: args.chromium, args: CHROMIUM_FLAGS });
   const analysis = await browser.newPage();
@@ -363,14 +378,32 @@ async function main() {
   try {
     for (const [when, t] of Object.entries(times)) {
       const at = start + BigInt(Math.round(t * 1e9));
-      const query = new URLSearchParams({ ds: "remote-file", "ds.url": logUrl, layoutId: LAYOUT_ID, time: rfc3339(at) });
+      const query = live
+        ? new URLSearchParams({ ds: "foxglove-websocket", "ds.url": live, layoutId: LAYOUT_ID })
+        : new URLSearchParams({ ds: "remote-file", "ds.url": logUrl, layoutId: LAYOUT_ID, time: rfc3339(at) });
       const pageUrl = `http://127.0.0.1:${sitePort}/scripts/viewers/foxglove/index.html?${query}`;
       const t0 = Date.now();
-      const shot = await capture(browser, pageUrl, panels, timeoutMs, analysis);
+      // Live: wait until the body and every plotted series are drawn.
+      const ready = live
+        ? async (png, regions) => {
+            const s3 = await analysis.evaluate(([p, r, c, tol, pd]) => window.regionStats(p, r, c, tol, pd), [
+              png, regions[threeD.title], [], COLOUR_TOLERANCE, PIXEL_DIFFERENCE,
+            ]);
+            if (s3.grey < MIN_BODY_PIXELS) return false;
+            for (const p of plots) {
+              const sp = await analysis.evaluate(([pn, r, c, tol, pd]) => window.regionStats(pn, r, c, tol, pd), [
+                png, regions[p.title], p.series.map((x) => x.colour), COLOUR_TOLERANCE, PIXEL_DIFFERENCE,
+              ]);
+              if (sp.colourPixels.some((n) => n < MIN_SERIES_PIXELS)) return false;
+            }
+            return true;
+          }
+        : undefined;
+      const shot = await capture(browser, pageUrl, panels, timeoutMs, analysis, ready);
       const file = join(args.out, `${name}-${when}.png`);
       await writeFile(file, Buffer.from(shot.png, "base64"));
       console.log(
-        `${when}: t = ${t} s (${rfc3339(at)}), shown ${shot.shownTime ?? "?"}, ${((Date.now() - t0) / 1000).toFixed(1)} s` +
+        `${when}: ${live ? live : `t = ${t} s (${rfc3339(at)})`}, shown ${shot.shownTime ?? "?"}, ${((Date.now() - t0) / 1000).toFixed(1)} s` +
           ` (settled after ${shot.settleSeconds.toFixed(1)} s) -> ${file}`,
       );
       for (const e of shot.errors) {
@@ -444,6 +477,13 @@ async function main() {
         if (!okBlank) problems.push(`${name}: plot "${p.title}" is blank`);
         if (!okSeries && !args.orbit) problems.push(`${name}: plot "${p.title}" misses a series (${perSeries})`);
       }
+    }
+    if (live) {
+      if (problems.length > 0) {
+        fail(problems.join("; "));
+      }
+      console.log(`PASS: Foxglove connected to the live run ${live} with the shipped layout; 3D panel and plots drawn`);
+      return;
     }
     // (b) The body moved: the 3D panel differs between the two times.
     const r = shots.early.regions[threeD.title];
