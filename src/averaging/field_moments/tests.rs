@@ -15,6 +15,25 @@ fn relative(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
     (a - b).amax() / b.amax()
 }
 
+/// The span of the time means (s): 60 days.
+const SPAN: f64 = 60.0 * 86_400.0;
+
+/// The mean of B Bᵀ along the orbit itself over [0, span] (s), sampled 40 times an orbit and
+/// weighted by sin⁴ (a window whose spectrum falls as f⁻⁵), for the instant span/2.
+fn smooth_time_mean(orbit: &Orbit, field: &GeomagneticField, span: f64) -> Matrix3<f64> {
+    let samples = (span / (orbit.period() / 40.0)) as usize;
+    let mut sum = Matrix3::zeros();
+    let mut weights = 0.0;
+    for i in 0..=samples {
+        let s = i as f64 / samples as f64;
+        let w = (std::f64::consts::PI * s).sin().powi(4);
+        let b = field.field_on_orbit(orbit, s * span);
+        sum += b * b.transpose() * w;
+        weights += w;
+    }
+    sum / weights
+}
+
 /// 2n + 3 points per angle give the double mean to rounding: the same as twice as many.
 #[test]
 fn the_double_mean_is_exact_on_2n_plus_3_points() {
@@ -78,22 +97,9 @@ fn the_double_mean_is_the_time_mean_along_the_orbit() {
         GeomagneticField::new(EPOCH_2020_06),
         GeomagneticField::igrf(EPOCH_2020_06, None),
     ] {
-        let span = 60.0 * 86_400.0;
-        let step = orbit.period() / 40.0;
-        let samples = (span / step) as usize;
-        let mut sum = Matrix3::zeros();
-        let mut weights = 0.0;
-        for i in 0..=samples {
-            let s = i as f64 / samples as f64;
-            // sin⁴: a window whose spectrum falls as f⁻⁵.
-            let w = (std::f64::consts::PI * s).sin().powi(4);
-            let b = field.field_on_orbit(&orbit, s * span);
-            sum += b * b.transpose() * w;
-            weights += w;
-        }
-        let time_mean = sum / weights;
+        let time_mean = smooth_time_mean(&orbit, &field, SPAN);
         let moments = FieldMoments::orbit(orbit.clone(), field.clone());
-        let s = moments.at(0.5 * span);
+        let s = moments.at(0.5 * SPAN);
         let off = relative(&s, &time_mean);
         println!("{}: {off:.2e}", field.describe());
         assert!(off < 1e-8, "{}: {off:.2e}", field.describe());
@@ -111,19 +117,8 @@ fn the_windows_follow_the_time_mean_on_an_eccentric_orbit() {
     let field = GeomagneticField::new(EPOCH_2020_06);
     let moments = FieldMoments::orbit(orbit.clone(), field.clone());
     assert!(matches!(moments, FieldMoments::Orbit { .. }));
-    let span = 60.0 * 86_400.0;
-    let step = orbit.period() / 40.0;
-    let samples = (span / step) as usize;
-    let mut sum = Matrix3::zeros();
-    let mut weights = 0.0;
-    for i in 0..=samples {
-        let s = i as f64 / samples as f64;
-        let w = (std::f64::consts::PI * s).sin().powi(4);
-        let b = field.field_on_orbit(&orbit, s * span);
-        sum += b * b.transpose() * w;
-        weights += w;
-    }
-    let off = relative(&moments.at(0.5 * span), &(sum / weights));
+    let time_mean = smooth_time_mean(&orbit, &field, SPAN);
+    let off = relative(&moments.at(0.5 * SPAN), &time_mean);
     println!("eccentric windows: {off:.2e}");
     assert!(off < 1e-3, "{off:.2e}");
 }
