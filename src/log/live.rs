@@ -1,7 +1,7 @@
 //! The live view (`polhode run --live`): the run served as it computes over the Foxglove
 //! WebSocket protocol, version 1 (Foxglove, "Foxglove WebSocket Protocol",
 //! <https://github.com/foxglove/ws-protocol/blob/main/docs/spec.md>). The server is one more
-//! outlet of the log ([`super::outlets`]): the same topics, schemas, channel metadata and
+//! outlet of the log (the private `log::outlets`): the same topics, schemas, channel metadata and
 //! encoded messages as the MCAP file, stamped with the same log times. A run without `--live`
 //! creates none of this (no socket, no thread).
 //!
