@@ -20,7 +20,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use polhode::montecarlo::Prepared;
+use polhode::montecarlo::{InvalidDraws, Prepared};
 use polhode::scenario::{self, Overrides, Scenario, ScenarioError};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -199,7 +199,12 @@ fuzz_target!(|data: &[u8]| {
     let nominal = &prep.scenario;
     match prep.build_run(0) {
         Ok((run, inputs)) => {
-            assert!(inputs.is_empty());
+            // No drawn inputs; under `invalid_draws: redraw` the run's count of redraws, 0.
+            let expected: &[f64] = match prep.campaign.invalid_draws {
+                InvalidDraws::Redraw => &[0.0],
+                InvalidDraws::Exclude => &[],
+            };
+            assert_eq!(inputs, expected, "the nominal run's inputs");
             same_scenario(nominal, &run);
         }
         Err(e) => panic!(
