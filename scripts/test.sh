@@ -13,9 +13,11 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 scripts/python-venv.sh
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --locked -- -D warnings
+# The main job and `pip install ./python` share one build of the library (docs/python.md).
+scripts/check-shared-build.sh
 # --workspace: the Python crate's dependencies join the feature resolution, so that
 # `pip install ./python` below reuses this build of the polhode library instead of compiling
-# it again (docs/python.md, "Build time in CI"). --tests covers the library's unit tests
+# it again (docs/python.md, "Build time"). --tests covers the library's unit tests
 # (every target with `test = true`); no --lib, which would also build a test harness of the
 # Python crate (`test = false`), linked against libpython.
 cargo test --release --locked --workspace --bins --tests
