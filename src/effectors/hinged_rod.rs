@@ -15,7 +15,7 @@
 //! momentum and its energy is a quadratic polynomial in s, which that rule integrates exactly.
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums, add_mass_and_first_moment};
-use crate::model::{Drawing, HubCoupling, Momentum, Validity};
+use crate::model::{Drawing, Grouping, HubCoupling, Momentum, Validity};
 use crate::sincos::sin_cos;
 use nalgebra::{Matrix3, Matrix6, Vector3};
 
@@ -139,6 +139,13 @@ impl ParticleModel for HingedRod {
     }
     fn kind(&self) -> &'static str {
         "hinged_rod"
+    }
+    /// A scene's flap–lag rods couple [`super::rod_lanes::LANES`] at a time, one per lane.
+    fn grouping(&self) -> Option<Grouping> {
+        (self.freedom == HingeFreedom::FlapLag).then_some(Grouping {
+            kind: "flap_lag_rods",
+            form: super::rod_lanes::RodLanes::form_groups,
+        })
     }
     fn undamped(&self) -> Self {
         HingedRod {

@@ -24,7 +24,7 @@
 //! exactly by the continuous equations (tested), whatever the kinematics.
 
 use crate::model::{
-    Drawing, Effector, EnergyAccount, HubAcceleration, HubCoupling, HubState, Momentum,
+    Drawing, Effector, EnergyAccount, Grouping, HubAcceleration, HubCoupling, HubState, Momentum,
     TidalCoupling, Validity,
 };
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
@@ -196,6 +196,10 @@ pub trait ParticleModel: Debug + Send + Sync {
     /// [`ParticleModel::validity_at`] in words ([`Effector::validity_report_at`]).
     fn validity_report_at(&self, _hub: &HubState, q: &[f64]) -> (String, String) {
         self.validity_report(q)
+    }
+    /// The kind of group it couples in with others of its scene ([`Effector::grouping`]).
+    fn grouping(&self) -> Option<Grouping> {
+        None
     }
 }
 
@@ -801,6 +805,10 @@ impl<P: ParticleModel + 'static> Effector for ParticleEffector<P> {
     fn validity_report_at(&self, hub: &HubState, x: &[f64]) -> (String, String) {
         self.model
             .validity_report_at(hub, &x[..self.model.num_coordinates()])
+    }
+
+    fn grouping(&self) -> Option<Grouping> {
+        self.model.grouping()
     }
 }
 

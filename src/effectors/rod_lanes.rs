@@ -193,6 +193,17 @@ impl RodLanes {
             .map(RodLanes::new)
             .collect()
     }
+
+    /// [`RodLanes::groups`] as the spacecraft takes them ([`crate::model::Grouping::form`]).
+    pub fn form_groups(
+        effectors: &[Box<dyn Effector>],
+        state_offsets: &[usize],
+    ) -> Vec<Box<dyn EffectorGroup>> {
+        RodLanes::groups(effectors, state_offsets)
+            .into_iter()
+            .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
+            .collect()
+    }
 }
 
 impl EffectorGroup for RodLanes {
@@ -431,6 +442,38 @@ mod tests {
         assert_eq!(members, vec![vec![0, 1, 3]]);
         assert!(RodLanes::groups(&effectors[..3], &states)[0].members() == [0, 1]);
         assert!(RodLanes::groups(&effectors[..1], &states).is_empty());
+    }
+
+    /// A spacecraft forms the same groups through the rods' own `grouping`, without naming
+    /// the rods: the hub's contract, as effectors are added one by one past a damper.
+    #[test]
+    fn a_spacecraft_groups_its_rods_through_the_effector_contract() {
+        use crate::effectors::Rayleigh;
+        use crate::model::{RigidBody, Spacecraft};
+        let hub = RigidBody::from_principal([10.0, 11.0, 12.0]).unwrap();
+        let mut spacecraft = Spacecraft::new(hub, Vector3::z());
+        spacecraft.hub_mass = Some(14.0);
+        let damper = Rayleigh {
+            name: "damper".into(),
+            gamma: nalgebra::Matrix3::identity() * 0.01,
+        };
+        spacecraft.add_effector(Box::new(damper)).unwrap();
+        for k in 0..7 {
+            let freedom = if k == 2 {
+                HingeFreedom::Flap
+            } else {
+                HingeFreedom::FlapLag
+            };
+            spacecraft.add_effector(rod(k, freedom)).unwrap();
+            if k == 0 {
+                assert!(spacecraft.group_members().is_empty(), "one rod stays alone");
+            }
+        }
+        // Effector indices are one past the rods' (the damper comes first).
+        assert_eq!(
+            spacecraft.group_members(),
+            vec![vec![1, 2, 4, 5], vec![6, 7]]
+        );
     }
 
     /// A group couples its rods as each rod's own `couple` and `derivatives` do, to

@@ -483,6 +483,42 @@ pub trait Effector: Any + Debug + Send + Sync {
     fn validity_report_at(&self, _hub: &HubState, x: &[f64]) -> (String, String) {
         self.validity_report(x)
     }
+    /// The kind of [`EffectorGroup`] it can be coupled in together with others of its scene
+    /// (the flap–lag rods, lane by lane), with the function that forms those groups; `None`
+    /// (the default) when it couples alone. The spacecraft calls each kind's function once
+    /// with all its effectors, so it never names an effector kind itself.
+    fn grouping(&self) -> Option<Grouping> {
+        None
+    }
+}
+
+/// A kind of [`EffectorGroup`], as an effector names it ([`Effector::grouping`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Grouping {
+    /// Names the kind: effectors that give the same name share one call of `form`.
+    pub kind: &'static str,
+    /// Forms the groups of this kind from all of a spacecraft's effectors and the offsets of
+    /// their states in the state vector; each group claims the members it couples, and an
+    /// effector left out keeps its own [`Effector::couple`].
+    pub form: FormGroups,
+}
+
+/// [`Grouping::form`]: all of a spacecraft's effectors and their state offsets in, the
+/// groups of one kind out.
+pub type FormGroups = fn(&[Box<dyn Effector>], &[usize]) -> Vec<Box<dyn EffectorGroup>>;
+
+/// The groups of every kind that `effectors` name, kinds in the order they first appear.
+fn form_groups(effectors: &[Box<dyn Effector>], offsets: &[usize]) -> Vec<Box<dyn EffectorGroup>> {
+    let mut kinds: Vec<Grouping> = Vec::new();
+    for grouping in effectors.iter().filter_map(|e| e.grouping()) {
+        if kinds.iter().all(|k| k.kind != grouping.kind) {
+            kinds.push(grouping);
+        }
+    }
+    kinds
+        .iter()
+        .flat_map(|k| (k.form)(effectors, offsets))
+        .collect()
 }
 
 /// A prescribed hub rotation (a motor drives the hub; its centre of mass is pinned).
@@ -507,9 +543,9 @@ impl std::fmt::Display for AddEffectorError {
 
 impl std::error::Error for AddEffectorError {}
 
-/// Several effectors coupled in one call, in place of their own [`Effector::couple`] (the
-/// scene's flap–lag rods, lane by lane: [`crate::effectors::rod_lanes`]). Used when no
-/// tidal field acts on the moving masses; the members' `couple` serves otherwise.
+/// Several effectors coupled in one call, in place of their own [`Effector::couple`] (such as
+/// the scene's flap–lag rods, lane by lane), formed through [`Effector::grouping`]. Used when
+/// no tidal field acts on the moving masses; the members' `couple` serves otherwise.
 pub trait EffectorGroup: Debug + Send + Sync {
     /// Indices of the member effectors in the spacecraft.
     fn members(&self) -> &[usize];
@@ -684,10 +720,7 @@ impl Spacecraft {
         self.scratch_len += effector.scratch_len();
         self.effectors.push(effector);
         self.alone = lone_mover(&self.effectors);
-        self.groups = crate::effectors::rod_lanes::RodLanes::groups(&self.effectors, &self.offsets)
-            .into_iter()
-            .map(|g| Box::new(g) as Box<dyn EffectorGroup>)
-            .collect();
+        self.groups = form_groups(&self.effectors, &self.offsets);
         self.grouped = vec![false; self.effectors.len()];
         for &k in self.groups.iter().flat_map(|g| g.members()) {
             self.grouped[k] = true;
@@ -722,6 +755,12 @@ impl Spacecraft {
     pub(crate) fn couple_alone_effector(&mut self, on: bool) {
         self.alone = lone_mover(&self.effectors).filter(|_| on);
         self.lone_only = self.only_the_lone_mover();
+    }
+
+    /// The members of each of its effector groups ([`Effector::grouping`]), for tests.
+    #[cfg(test)]
+    pub(crate) fn group_members(&self) -> Vec<Vec<usize>> {
+        self.groups.iter().map(|g| g.members().to_vec()).collect()
     }
 
     /// Prescribes the hub's rotation (its centre of mass is then pinned in inertial space).
