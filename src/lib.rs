@@ -119,6 +119,7 @@ pub mod bench;
 pub mod chebyshev;
 pub mod cli;
 pub mod compare;
+pub mod cpu;
 pub mod effectors;
 pub mod exact;
 pub mod integrate;

@@ -86,6 +86,8 @@ pub struct RodLanes {
     damping: [Lanes; 2],
     /// Σ (m − μ) [[1, −[h×]], [[h×], |h|² 1 − h hᵀ]] over the rods in use (lower triangle).
     constant_mass: Matrix6<f64>,
+    /// Run the versions compiled for AVX2 (the processor has it, checked once at build).
+    avx2: bool,
 }
 
 impl RodLanes {
@@ -110,6 +112,7 @@ impl RodLanes {
             stiffness: [[0.0; LANES]; 2],
             damping: [[0.0; LANES]; 2],
             constant_mass: Matrix6::zeros(),
+            avx2: crate::cpu::avx2_available(),
         };
         for r in 0..LANES {
             let used = r < rods.len();
@@ -206,17 +209,11 @@ impl RodLanes {
     }
 }
 
-impl EffectorGroup for RodLanes {
-    fn members(&self) -> &[usize] {
-        &self.members
-    }
-
-    fn scratch_len(&self) -> usize {
-        ROWS * LANES
-    }
-
+/// The group's arithmetic, inlined into each instruction-set version of it below.
+impl RodLanes {
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
-    fn momentum(&self, hub: &HubState, y: &[f64]) -> Momentum {
+    #[inline(always)]
+    fn momentum_lanes(&self, hub: &HubState, y: &[f64]) -> Momentum {
         let omega = hub.omega;
         let (angles, sines) = self.angles(y);
         let mut sum = Momentum::default();
@@ -239,7 +236,14 @@ impl EffectorGroup for RodLanes {
     }
 
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
-    fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
+    #[inline(always)]
+    fn couple_lanes(
+        &self,
+        hub: &HubState,
+        y: &[f64],
+        coupling: &mut HubCoupling,
+        scratch: &mut [f64],
+    ) {
         let omega = hub.omega;
         let w2 = omega.norm_squared();
         let (angles, sines) = self.angles(y);
@@ -335,7 +339,14 @@ impl EffectorGroup for RodLanes {
     }
 
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
-    fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]) {
+    #[inline(always)]
+    fn derivatives_lanes(
+        &self,
+        accel: &HubAcceleration,
+        y: &[f64],
+        scratch: &[f64],
+        dydt: &mut [f64],
+    ) {
         let z = accel.as_vector6();
         let rows = &scratch[..ROWS * LANES];
         // u̇ = W_g − W_C z (L = 1), as `ParticleEffector::derivatives`, lane by lane.
@@ -361,6 +372,76 @@ impl EffectorGroup for RodLanes {
                     + self.damping[1][r] * lag_rate * lag_rate,
             ]);
         }
+    }
+}
+
+/// The same arithmetic compiled for AVX2, where the four lanes fill one 256-bit register
+/// instead of two 128-bit ones. Rust contracts no multiply–add into an FMA by itself, so
+/// these give the baseline build's bits (tested).
+#[cfg(target_arch = "x86_64")]
+impl RodLanes {
+    #[target_feature(enable = "avx2")]
+    fn momentum_avx2(&self, hub: &HubState, y: &[f64]) -> Momentum {
+        self.momentum_lanes(hub, y)
+    }
+
+    #[target_feature(enable = "avx2")]
+    fn couple_avx2(
+        &self,
+        hub: &HubState,
+        y: &[f64],
+        coupling: &mut HubCoupling,
+        scratch: &mut [f64],
+    ) {
+        self.couple_lanes(hub, y, coupling, scratch)
+    }
+
+    #[target_feature(enable = "avx2")]
+    fn derivatives_avx2(
+        &self,
+        accel: &HubAcceleration,
+        y: &[f64],
+        scratch: &[f64],
+        dydt: &mut [f64],
+    ) {
+        self.derivatives_lanes(accel, y, scratch, dydt)
+    }
+}
+
+impl EffectorGroup for RodLanes {
+    fn members(&self) -> &[usize] {
+        &self.members
+    }
+
+    fn scratch_len(&self) -> usize {
+        ROWS * LANES
+    }
+
+    fn momentum(&self, hub: &HubState, y: &[f64]) -> Momentum {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only where the processor has AVX2.
+            return unsafe { self.momentum_avx2(hub, y) };
+        }
+        self.momentum_lanes(hub, y)
+    }
+
+    fn couple(&self, hub: &HubState, y: &[f64], coupling: &mut HubCoupling, scratch: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: as above.
+            return unsafe { self.couple_avx2(hub, y, coupling, scratch) };
+        }
+        self.couple_lanes(hub, y, coupling, scratch)
+    }
+
+    fn derivatives(&self, accel: &HubAcceleration, y: &[f64], scratch: &[f64], dydt: &mut [f64]) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: as above.
+            return unsafe { self.derivatives_avx2(accel, y, scratch, dydt) };
+        }
+        self.derivatives_lanes(accel, y, scratch, dydt)
     }
 }
 
@@ -582,6 +663,30 @@ mod tests {
                     each.kinetic_energy += m.kinetic_energy;
                 }
                 let sum = group.momentum(&hub, &y);
+                // The baseline build of the same arithmetic gives the same bits as the one
+                // this processor runs (AVX2 where it has it).
+                let mut baseline = group.clone();
+                baseline.avx2 = false;
+                let mut baseline_coupling = start();
+                let mut baseline_scratch = vec![0.0; group.scratch_len()];
+                baseline.couple(&hub, &y, &mut baseline_coupling, &mut baseline_scratch);
+                let mut d_baseline = vec![0.0; dim];
+                baseline.derivatives(&accel, &y, &baseline_scratch, &mut d_baseline);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(together.mass.as_slice()),
+                    bits(baseline_coupling.mass.as_slice())
+                );
+                assert_eq!(
+                    bits(together.force.as_slice()),
+                    bits(baseline_coupling.force.as_slice())
+                );
+                assert_eq!(bits(&d_together), bits(&d_baseline));
+                assert_eq!(bits(&own), bits(&baseline_scratch));
+                assert_eq!(
+                    format!("{sum:?}"),
+                    format!("{:?}", baseline.momentum(&hub, &y))
+                );
                 close(&[sum.mass], &[each.mass], "mass");
                 close(
                     &[sum.kinetic_energy],

@@ -200,6 +200,40 @@ pub struct Tolerances {
     pub atol: f64,
 }
 
+/// [`combine`] through its build for AVX2 when `avx2` (the caller asked
+/// [`crate::cpu::avx2_available`] once): the same bits, four lanes per instruction.
+#[inline(always)]
+pub(crate) fn combine_on<const M: usize>(
+    avx2: bool,
+    out: &mut [f64],
+    base: &[f64],
+    h: f64,
+    a: [f64; M],
+    k: [&[f64]; M],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: `avx2` is true only where the processor has AVX2.
+        unsafe { combine_avx2(out, base, h, a, k) };
+        return;
+    }
+    let _ = avx2;
+    combine(out, base, h, a, k)
+}
+
+/// [`combine`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn combine_avx2<const M: usize>(
+    out: &mut [f64],
+    base: &[f64],
+    h: f64,
+    a: [f64; M],
+    k: [&[f64]; M],
+) {
+    combine(out, base, h, a, k)
+}
+
 /// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument). The slices are cut to `out.len()` first
 /// so the loops carry no bounds checks; the `M` terms are unrolled; the increments are summed
 /// before they are added to `base`, as in the textbook formula.

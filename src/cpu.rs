@@ -1,0 +1,20 @@
+//! What the processor can do, asked at run time, so that one binary (built for baseline
+//! x86-64) runs its hottest loops through versions compiled for wider vector instructions
+//! where the processor has them (`#[target_feature]` functions, chosen once when a
+//! spacecraft or stepper is built).
+//!
+//! Rust never contracts a multiply and an add into a fused multiply–add by itself, so a loop
+//! compiled for AVX2 gives the baseline build's bits: only the width of the registers
+//! changes, and every step, event and printed number stays the same.
+
+/// Whether this processor has AVX2 (four f64 per vector instruction instead of two).
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
