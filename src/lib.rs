@@ -122,6 +122,7 @@ pub mod compare;
 pub mod effectors;
 pub mod exact;
 pub mod integrate;
+pub mod lanes;
 pub mod linearize;
 pub mod log;
 pub mod model;
