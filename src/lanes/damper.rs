@@ -6,7 +6,7 @@
 //! state, hub and damper parameters, end time, step size, error control, accept/reject and
 //! work counters. Every lane evaluates every stage (lockstep, as DiffEqGPU.jl's
 //! `EnsembleGPUKernel` does on GPUs: U. Utkarsh et al., "Automated translation and accelerated
-//! solving of differential equation on multiple GPU platforms", Comput. Methods Appl. Mech.
+//! solving of differential equations on multiple GPU platforms", Comput. Methods Appl. Mech.
 //! Eng. 419 (2024) 116591); the decisions are taken per lane under masks. A lane whose run has
 //! ended takes the next run. The arithmetic is the scalar path's, generic over the lane
 //! (dopri5's stages, error norm and controller in `integrate::dopri5`, the damper's closed
