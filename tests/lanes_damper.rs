@@ -43,13 +43,21 @@ impl Draws {
     }
 }
 
-/// `count` runs of scenarios/nutation-damper.yaml with dispersed ω₀, attitude, damper state
-/// and damper mass, stiffness and damping, ending at `t_end(i)`.
+/// `count` runs of scenarios/nutation-damper.yaml with dispersed products of inertia, ω₀,
+/// attitude, damper state and damper mass, stiffness and damping, ending at `t_end(i)`.
 fn dispersed_runs(count: usize, seed: u64, t_end: impl Fn(usize) -> f64) -> Vec<DamperRun> {
     let mut d = Draws(seed);
     (0..count)
         .map(|i| DamperRun {
-            hub_inertia: Matrix3::from_diagonal(&Vector3::new(1375.7, 1292.5, 1402.4)),
+            hub_inertia: {
+                // Products of inertia too, so that every entry of the matrix is read.
+                let (xy, xz, yz) = (
+                    d.uniform(-8.0, 8.0),
+                    d.uniform(-8.0, 8.0),
+                    d.uniform(-8.0, 8.0),
+                );
+                Matrix3::new(1375.7, xy, xz, xy, 1292.5, yz, xz, yz, 1402.4)
+            },
             hub_mass: 5274.4,
             damper: SpringMass {
                 mass: 52.744 * d.uniform(0.8, 1.2),

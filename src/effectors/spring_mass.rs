@@ -107,8 +107,9 @@ impl SpringMass {
 
 // The lanes' form of the closed forms below (crate::lanes::damper). The scalar path keeps
 // its nalgebra form: the generic form at f64 gave the same bits but cost 3.7% more instructions
-// on scenarios/nutation-damper.yaml (docs/montecarlo.md, "Lanes: the foundation"). The lane
-// tests (tests/lanes_damper.rs) check that the two agree bit for bit, run by run.
+// on scenarios/nutation-damper.yaml with matrices as rows, 1.8% with them as columns as here
+// (docs/montecarlo.md, "Lanes: the foundation"). The lane tests (tests/lanes_damper.rs) check
+// that the two agree bit for bit, run by run.
 
 /// A spring–mass damper's parameters in lanes (one damper per lane): what its closed forms
 /// read, generic over the lane type so that the scalar path (at `f64`, through
@@ -216,7 +217,7 @@ impl<L: Lane> SpringMassLanes<L> {
     }
 
     /// The whole right-hand side of a hub (inertia `hub_inertia`, kg m² about its centre of
-    /// mass, as rows; mass `hub_mass`, kg) carrying this damper alone, in closed form
+    /// mass, as columns; mass `hub_mass`, kg) carrying this damper alone, in closed form
     /// ([`ParticleModel::rhs_alone_closed_form`]): ω̇ and ρ̈ at offset `q` (m), rate `u`
     /// (m/s) and hub rate `omega` (rad/s). The direction must be a unit vector.
     #[inline(always)]
@@ -229,9 +230,10 @@ impl<L: Lane> SpringMassLanes<L> {
         hub_mass: L,
     ) -> LoneAccelerations<L> {
         let terms = self.reduction(q, u, omega, hub_mass);
+        // Column j, row i: m[j][i].
         let mut m = *hub_inertia;
         for (i, j, added) in terms.added_inertia() {
-            m[i][j] += added;
+            m[j][i] += added;
         }
         let gyroscopic = linalg::cross(omega, linalg::mat_vec(hub_inertia, omega));
         let force = linalg::sub(
@@ -239,7 +241,7 @@ impl<L: Lane> SpringMassLanes<L> {
             terms.moment,
         );
         let (inverse, solved) =
-            linalg::spd_inverse3(m[0][0], m[1][0], m[2][0], m[1][1], m[2][1], m[2][2]);
+            linalg::spd_inverse3(m[0][0], m[0][1], m[0][2], m[1][1], m[1][2], m[2][2]);
         let w = linalg::mat_vec(&inverse, force);
         let t = terms.t;
         LoneAccelerations {

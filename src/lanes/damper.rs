@@ -305,7 +305,7 @@ impl<L: Lane> Lanes<L> {
             set(&mut d.position[j], run.damper.position[j]);
             set(&mut d.direction[j], run.damper.direction[j]);
             for c in 0..3 {
-                set(&mut self.system.hub_inertia[j][c], run.hub_inertia[(j, c)]);
+                set(&mut self.system.hub_inertia[c][j], run.hub_inertia[(j, c)]);
             }
         }
         set(&mut self.system.hub_mass, run.hub_mass);

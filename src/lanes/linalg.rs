@@ -1,5 +1,6 @@
-//! Small vector algebra in lanes: 3-vectors as `[L; 3]`, 3 × 3 matrices as rows
-//! `[[L; 3]; 3]` (`m[i][j]` is row i, column j), and the hub's quaternion kinematics.
+//! Small vector algebra in lanes: 3-vectors as `[L; 3]`, 3 × 3 matrices as columns
+//! `[[L; 3]; 3]` (`m[j][i]` is row i, column j: nalgebra's storage), and the hub's quaternion
+//! kinematics.
 //!
 //! Each operation sums in the order nalgebra does for `Vector3<f64>` and `Matrix3<f64>`
 //! (`dot`: x + y + z left to right; `cross`: `a_y b_z − a_z b_y`, …; a matrix times a vector:
@@ -42,14 +43,17 @@ pub fn sub<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-/// `m x` for a 3 × 3 matrix given by rows.
+/// `m x` for a 3 × 3 matrix given by columns: column 0 times x₀, plus column 1 times x₁, plus
+/// column 2 times x₂.
 #[inline(always)]
 pub fn mat_vec<L: Lane>(m: &[[L; 3]; 3], x: [L; 3]) -> [L; 3] {
-    std::array::from_fn(|i| m[i][0] * x[0] + m[i][1] * x[1] + m[i][2] * x[2])
+    let y = scale(x[0], m[0]);
+    let y = add(scale(x[1], m[1]), y);
+    add(scale(x[2], m[2]), y)
 }
 
-/// The inverse of a symmetric 3 × 3 matrix [[a, b, c], [b, d, e], [c, e, f]] by its cofactors,
-/// as rows, and the lanes in which it is positive definite (Sylvester's criterion: a, a d − b²
+/// The inverse of a symmetric 3 × 3 matrix [[a, b, c], [b, d, e], [c, e, f]] by its cofactors
+/// (symmetric: its rows are its columns), and the lanes in which it is positive definite (Sylvester's criterion: a, a d − b²
 /// and the determinant positive); the other lanes' inverse is meaningless. The same cofactors
 /// as `model::spd_inverse3`, which the general path keeps for itself.
 #[inline(always)]
@@ -97,15 +101,10 @@ mod tests {
         let a = Vector3::new(0.3, -1.7e-3, 2.9);
         let b = Vector3::new(-4.1, 0.77, 1.0 / 3.0);
         let m = Matrix3::new(1.1, 0.2, -0.3, 0.25, 2.2, 0.4, -0.35, 0.45, 3.3);
-        let rows = [
-            [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
-            [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
-            [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
-        ];
         let (av, bv) = ([a.x, a.y, a.z], [b.x, b.y, b.z]);
         assert_eq!(dot(av, bv).to_bits(), a.dot(&b).to_bits());
         assert_eq!(cross(av, bv), <[f64; 3]>::from(a.cross(&b)));
-        assert_eq!(mat_vec(&rows, av), <[f64; 3]>::from(m * a));
+        assert_eq!(mat_vec(&m.data.0, av), <[f64; 3]>::from(m * a));
     }
 
     #[test]
