@@ -123,6 +123,7 @@ pub mod cpu;
 pub mod effectors;
 pub mod exact;
 pub mod integrate;
+pub mod lanes;
 pub mod linearize;
 pub mod log;
 pub mod model;

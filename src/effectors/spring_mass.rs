@@ -6,6 +6,7 @@
 //! couple correctly through the hub.
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
+use crate::lanes::{Lane, linalg};
 use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
 use nalgebra::{Matrix3, Vector3};
 
@@ -101,6 +102,172 @@ impl SpringMass {
             free_acceleration: generalised / m_star - pc,
             moment: r.cross(&pull),
         })
+    }
+}
+
+// The lanes' form of the closed forms below (crate::lanes::damper). The scalar path keeps
+// its nalgebra form: the generic form at f64 gave the same bits but cost 3.7% more instructions
+// on scenarios/nutation-damper.yaml with matrices as rows, 1.8% with them as columns as here
+// (docs/montecarlo.md, "Lanes: the foundation"). The lane tests (tests/lanes_damper.rs) check
+// that the two agree bit for bit, run by run.
+
+/// A spring–mass damper's parameters in lanes (one damper per lane): what its closed forms
+/// read, generic over the lane type so that the scalar path (at `f64`, through
+/// [`SpringMass::lanes`]) and the lockstep ensembles (crate::lanes::damper) run one code.
+#[derive(Debug, Clone, Copy)]
+pub struct SpringMassLanes<L> {
+    /// Particle mass (kg).
+    pub mass: L,
+    /// Point of the line at ρ = 0 (m, body axes, about the hub's centre of mass).
+    pub position: [L; 3],
+    /// Unit direction of the line (body axes).
+    pub direction: [L; 3],
+    /// Spring stiffness k (N/m).
+    pub stiffness: L,
+    /// Dashpot coefficient c (N s/m).
+    pub damping: L,
+}
+
+/// [`Reduction`] per lane.
+struct ReductionLanes<L> {
+    /// Reduced mass m* = m M/(M + m) (kg).
+    reduced_mass: L,
+    /// Particle position r (m, body axes).
+    r: [L; 3],
+    /// t = r × p̂ (m).
+    t: [L; 3],
+    /// ρ̈ at ω̇ = 0: Q/m* − p̂·c (m/s²).
+    free_acceleration: L,
+    /// r × (m* (c − p̂ (p̂·c)) + p̂ Q) (N m).
+    moment: [L; 3],
+}
+
+impl<L: Lane> ReductionLanes<L> {
+    /// The entries (row, column, value) of m* (|r|² 1 − r rᵀ − t tᵀ) on and below the
+    /// diagonal (kg m²).
+    #[inline(always)]
+    fn added_inertia(&self) -> [(usize, usize, L); 6] {
+        let (r, t, r2) = (self.r, self.t, linalg::dot(self.r, self.r));
+        let entry = |i: usize, j: usize| {
+            let diagonal = if i == j { r2 } else { L::splat(0.0) };
+            (
+                i,
+                j,
+                self.reduced_mass * (diagonal - r[i] * r[j] - t[i] * t[j]),
+            )
+        };
+        [
+            entry(0, 0),
+            entry(1, 0),
+            entry(2, 0),
+            entry(1, 1),
+            entry(2, 1),
+            entry(2, 2),
+        ]
+    }
+}
+
+/// The lone damper's closed-form accelerations ([`SpringMassLanes::lone_accelerations`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LoneAccelerations<L: Lane> {
+    /// The hub's angular acceleration ω̇ (rad/s², body axes).
+    pub omega_dot: [L; 3],
+    /// The offset's acceleration ρ̈ (m/s²).
+    pub u_dot: L,
+    /// Lanes whose 3 × 3 system was positive definite (elsewhere the values are meaningless).
+    pub solved: L::Mask,
+}
+
+impl<L: Lane> SpringMassLanes<L> {
+    /// The generalised force of spring and dashpot, −kρ − cρ̇ (N), at offset `q` (m) and rate
+    /// `u` (m/s).
+    #[inline(always)]
+    pub fn force(&self, q: L, u: L) -> L {
+        -self.stiffness * q - self.damping * u
+    }
+
+    /// The power the dashpot dissipates, c ρ̇² (W), at rate `u` (m/s).
+    #[inline(always)]
+    pub fn dissipation_power(&self, u: L) -> L {
+        self.damping * u * u
+    }
+
+    /// The two-body reduction's terms at offset `q`, rate `u` and hub rate `omega`, with hub
+    /// mass `hub_mass` (kg), for a unit direction.
+    #[inline(always)]
+    fn reduction(&self, q: L, u: L, omega: [L; 3], hub_mass: L) -> ReductionLanes<L> {
+        use linalg::{add, cross, dot, scale, sub};
+        let (p, rho_dot) = (self.direction, u);
+        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
+        let r = add(self.position, scale(q, p));
+        let c = add(
+            cross(omega, cross(omega, r)),
+            scale(L::splat(2.0) * rho_dot, cross(omega, p)),
+        );
+        let generalised = self.force(q, u);
+        let pc = dot(p, c);
+        let pull = add(scale(m_star, sub(c, scale(pc, p))), scale(generalised, p));
+        ReductionLanes {
+            reduced_mass: m_star,
+            r,
+            t: cross(r, p),
+            free_acceleration: generalised / m_star - pc,
+            moment: cross(r, pull),
+        }
+    }
+
+    /// The whole right-hand side of a hub (inertia `hub_inertia`, kg m² about its centre of
+    /// mass, as columns; mass `hub_mass`, kg) carrying this damper alone, in closed form
+    /// ([`ParticleModel::rhs_alone_closed_form`]): ω̇ and ρ̈ at offset `q` (m), rate `u`
+    /// (m/s) and hub rate `omega` (rad/s). The direction must be a unit vector.
+    #[inline(always)]
+    pub fn lone_accelerations(
+        &self,
+        q: L,
+        u: L,
+        omega: [L; 3],
+        hub_inertia: &[[L; 3]; 3],
+        hub_mass: L,
+    ) -> LoneAccelerations<L> {
+        let terms = self.reduction(q, u, omega, hub_mass);
+        // Column j, row i: m[j][i].
+        let mut m = *hub_inertia;
+        for (i, j, added) in terms.added_inertia() {
+            m[j][i] += added;
+        }
+        let gyroscopic = linalg::cross(omega, linalg::mat_vec(hub_inertia, omega));
+        let force = linalg::sub(
+            [-gyroscopic[0], -gyroscopic[1], -gyroscopic[2]],
+            terms.moment,
+        );
+        let (inverse, solved) =
+            linalg::spd_inverse3(m[0][0], m[0][1], m[0][2], m[1][1], m[1][2], m[2][2]);
+        let w = linalg::mat_vec(&inverse, force);
+        let t = terms.t;
+        LoneAccelerations {
+            omega_dot: w,
+            u_dot: terms.free_acceleration - t[0] * w[0] - t[1] * w[1] - t[2] * w[2],
+            solved,
+        }
+    }
+}
+
+impl SpringMass {
+    /// Its parameters as one lane.
+    pub fn lanes(&self) -> SpringMassLanes<f64> {
+        SpringMassLanes {
+            mass: self.mass,
+            position: self.position.into(),
+            direction: self.direction.into(),
+            stiffness: self.stiffness,
+            damping: self.damping,
+        }
+    }
+
+    /// Whether its direction is a unit vector, as the closed forms are written for (scenarios
+    /// give one); they decline otherwise.
+    pub fn has_unit_direction(&self) -> bool {
+        (self.direction.norm_squared() - 1.0).abs() <= 1e-12
     }
 }
 

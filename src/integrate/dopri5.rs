@@ -5,6 +5,7 @@
 //! described in Hairer, Nørsett & Wanner, *Solving ODEs I* (2nd ed.), §II.4–II.6.
 
 use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine};
+use crate::lanes::Lane;
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -98,114 +99,292 @@ impl Dopri5 {
         self.h
     }
 
-    fn scale(&self, y0: f64, y1: f64) -> f64 {
-        self.tol.atol + self.tol.rtol * y0.abs().max(y1.abs())
-    }
-
     /// Initial step by the heuristic of Hairer, Nørsett & Wanner (§II.4, "starting step size").
     fn initial_step<S: OdeSystem + ?Sized>(&mut self, sys: &S, span: f64) -> f64 {
-        let n = self.y.len() as f64;
-        let (mut d0, mut d1) = (0.0, 0.0);
-        for i in 0..self.y.len() {
-            let sc = self.scale(self.y[i], self.y[i]);
-            d0 += (self.y[i] / sc).powi(2);
-            d1 += (self.k[0][i] / sc).powi(2);
-        }
-        let (d0, d1) = ((d0 / n).sqrt(), (d1 / n).sqrt());
-        let mut h0 = if d0 < 1e-10 || d1 < 1e-10 {
-            1e-6
-        } else {
-            0.01 * d0 / d1
-        };
-        h0 = h0.min(self.h_max).min(span);
-        for i in 0..self.y.len() {
-            self.stage[i] = self.y[i] + h0 * self.k[0][i];
-        }
-        sys.rhs(self.t + h0, &self.stage, &mut self.k[1]);
+        let [k1, k2, ..] = &mut self.k;
         self.stats.rhs_evaluations += 1;
-        let mut d2 = 0.0;
-        for i in 0..self.y.len() {
-            let sc = self.scale(self.y[i], self.y[i]);
-            d2 += ((self.k[1][i] - self.k[0][i]) / sc).powi(2);
-        }
-        let d2 = (d2 / n).sqrt() / h0;
-        let h1 = if d1.max(d2) <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / d1.max(d2)).powf(1.0 / 5.0)
-        };
-        let h = (100.0 * h0).min(h1).min(self.h_max).min(span);
-        // Scaled norms can overflow (tiny atol, huge states): fall back to a small step and
-        // let the controller find its way from there.
-        if h.is_finite() && h > 0.0 {
-            h
-        } else {
-            (1e-6 * span).min(self.h_max)
-        }
+        initial_step(
+            &mut SystemRhs(sys),
+            self.t,
+            &self.y,
+            k1,
+            k2,
+            &mut self.stage,
+            self.tol.atol,
+            self.tol.rtol,
+            self.h_max,
+            span,
+        )
     }
 
     /// Evaluates stages 2–7 for step `h` from `(t, y)` with `k[0] = f(t, y)`; returns the
     /// scaled RMS error estimate (non-finite if the stages were).
     fn attempt<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> f64 {
-        let t = self.t;
-        let n = self.y.len();
-        let [k1, k2, k3, k4, k5, k6, k7] = &mut self.k;
-        let (y, s) = (&self.y[..], &mut self.stage[..]);
-        // Stage 2 as (h a₂₁) k₁, as it has always been rounded; the others through `combine`.
-        for (si, (&yi, &k1i)) in s.iter_mut().zip(y.iter().zip(&k1[..n])) {
-            *si = yi + h * A21 * k1i;
-        }
-        sys.rhs(t + C2 * h, s, k2);
-        combine(s, y, h, [A31, A32], [k1, k2]);
-        sys.rhs(t + C3 * h, s, k3);
-        combine(s, y, h, [A41, A42, A43], [k1, k2, k3]);
-        sys.rhs(t + C4 * h, s, k4);
-        combine(s, y, h, [A51, A52, A53, A54], [k1, k2, k3, k4]);
-        sys.rhs(t + C5 * h, s, k5);
-        combine(s, y, h, [A61, A62, A63, A64, A65], [k1, k2, k3, k4, k5]);
-        sys.rhs(t + h, s, k6);
-        let y_new = &mut self.y_new[..];
-        combine(y_new, y, h, [A71, A73, A74, A75, A76], [k1, k3, k4, k5, k6]);
-        sys.rhs(t + h, y_new, k7);
+        stages(
+            &mut SystemRhs(sys),
+            self.t,
+            h,
+            &self.y,
+            &mut self.k,
+            &mut self.stage,
+            &mut self.y_new,
+        );
         self.stats.rhs_evaluations += 6;
-        let mut err = 0.0;
-        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
-        let (y_new, y) = (&y_new[..n], &y[..n]);
-        let (atol, rtol) = (self.tol.atol, self.tol.rtol);
-        for i in 0..n {
-            let e =
-                h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
-            let sc = atol + rtol * y[i].abs().max(y_new[i].abs());
-            err += (e / sc).powi(2);
-        }
-        (err / n as f64).sqrt()
+        error_norm(
+            h,
+            &self.k,
+            &self.y,
+            &self.y_new,
+            self.tol.atol,
+            self.tol.rtol,
+        )
     }
 
     fn store_dense_output(&mut self, h: f64) {
-        let n = self.y.len();
-        let [k1, _, k3, k4, k5, k6, k7] = &self.k;
-        let (k1, k3, k4, k5, k6, k7) = (&k1[..n], &k3[..n], &k4[..n], &k5[..n], &k6[..n], &k7[..n]);
-        let [c1, c2, c3, c4, c5] = &mut self.cont;
-        let (c1, c2, c3, c4, c5) = (
-            &mut c1[..n],
-            &mut c2[..n],
-            &mut c3[..n],
-            &mut c4[..n],
-            &mut c5[..n],
-        );
-        let (y, y_new) = (&self.y[..n], &self.y_new[..n]);
-        for i in 0..n {
-            let dy = y_new[i] - y[i];
-            let bspl = h * k1[i] - dy;
-            c1[i] = y[i];
-            c2[i] = dy;
-            c3[i] = bspl;
-            c4[i] = dy - h * k7[i] - bspl;
-            c5[i] =
-                h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i]);
-        }
+        dense_coefficients(h, &self.k, &self.y, &self.y_new, &mut self.cont);
     }
 }
+
+/// A right-hand side `f(t, y)` evaluated at the stages, per lane.
+pub(crate) trait StageRhs<L: Lane> {
+    /// Writes `f(t, y)` into `dydt`.
+    fn eval(&mut self, t: L, y: &[L], dydt: &mut [L]);
+}
+
+/// An [`OdeSystem`] as the scalar stages' right-hand side (inlined into them, as the system's
+/// `rhs` was before the stages were generic).
+struct SystemRhs<'a, S: ?Sized>(&'a S);
+
+impl<S: OdeSystem + ?Sized> StageRhs<f64> for SystemRhs<'_, S> {
+    #[inline(always)]
+    fn eval(&mut self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        self.0.rhs(t, y, dydt);
+    }
+}
+
+// The step's arithmetic, generic over the lane type: at `f64` it is the scalar `Dopri5`'s,
+// at a wider lane the lockstep ensembles' (crate::lanes), one lane per run. Each function
+// rounds as the scalar method always has, so a lane's numbers are the scalar run's.
+
+/// Initial step (s) by the heuristic of Hairer, Nørsett & Wanner (§II.4, "starting step
+/// size") from `(t, y)` with `k1 = f(t, y)`, for a span `span` (s) and a cap `h_max` (s);
+/// evaluates `rhs` once (into `k2`, with `stage` as scratch).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn initial_step<L: Lane>(
+    rhs: &mut impl StageRhs<L>,
+    t: L,
+    y: &[L],
+    k1: &mut [L],
+    k2: &mut [L],
+    stage: &mut [L],
+    atol: L,
+    rtol: L,
+    h_max: L,
+    span: L,
+) -> L {
+    let n = y.len();
+    let (k1, k2, stage) = (&k1[..n], &mut k2[..n], &mut stage[..n]);
+    let count = L::splat(n as f64);
+    let scale = |yi: L| atol + rtol * yi.abs().max(yi.abs());
+    let (mut d0, mut d1) = (L::splat(0.0), L::splat(0.0));
+    for i in 0..n {
+        let sc = scale(y[i]);
+        let (a, b) = (y[i] / sc, k1[i] / sc);
+        d0 += a * a;
+        d1 += b * b;
+    }
+    let (d0, d1) = ((d0 / count).sqrt(), (d1 / count).sqrt());
+    let tiny = L::splat(1e-10);
+    let h0 = L::select(
+        d0.less_than(tiny) | d1.less_than(tiny),
+        L::splat(1e-6),
+        L::splat(0.01) * d0 / d1,
+    );
+    let h0 = h0.min(h_max).min(span);
+    for i in 0..n {
+        stage[i] = y[i] + h0 * k1[i];
+    }
+    rhs.eval(t + h0, stage, k2);
+    let mut d2 = L::splat(0.0);
+    for i in 0..n {
+        let sc = scale(y[i]);
+        let a = (k2[i] - k1[i]) / sc;
+        d2 += a * a;
+    }
+    let d2 = (d2 / count).sqrt() / h0;
+    let d12 = d1.max(d2);
+    let h1 = L::select(
+        d12.at_most(L::splat(1e-15)),
+        (h0 * L::splat(1e-3)).max(L::splat(1e-6)),
+        (L::splat(0.01) / d12).powf(1.0 / 5.0),
+    );
+    let h = (L::splat(100.0) * h0).min(h1).min(h_max).min(span);
+    // Scaled norms can overflow (tiny atol, huge states): fall back to a small step and let
+    // the controller find its way from there.
+    L::select(
+        h.is_finite() & h.greater_than(L::splat(0.0)),
+        h,
+        (L::splat(1e-6) * span).min(h_max),
+    )
+}
+
+/// Evaluates stages 2–7 of a step `h` (s) from `(t, y)` with `k[0] = f(t, y)`: the stages
+/// into `k[1..]`, the fifth-order solution into `y_new` (and `k[6] = f(t + h, y_new)`, the
+/// next step's first stage), with `stage` as scratch. `rhs(t, y, dydt)` is the system.
+#[inline(always)]
+pub(crate) fn stages<L: Lane, K: AsMut<[L]>>(
+    rhs: &mut impl StageRhs<L>,
+    t: L,
+    h: L,
+    y: &[L],
+    k: &mut [K; 7],
+    stage: &mut [L],
+    y_new: &mut [L],
+) {
+    let n = y.len();
+    let [k1, k2, k3, k4, k5, k6, k7] = k;
+    let (k1, k2, k3, k4) = (k1.as_mut(), k2.as_mut(), k3.as_mut(), k4.as_mut());
+    let (k5, k6, k7) = (k5.as_mut(), k6.as_mut(), k7.as_mut());
+    let s = &mut stage[..n];
+    // Stage 2 as (h a₂₁) k₁, as it has always been rounded; the others through `combine`.
+    for (si, (&yi, &k1i)) in s.iter_mut().zip(y.iter().zip(&k1[..n])) {
+        *si = yi + h * L::splat(A21) * k1i;
+    }
+    rhs.eval(t + L::splat(C2) * h, s, k2);
+    combine(s, y, h, [A31, A32], [k1, k2]);
+    rhs.eval(t + L::splat(C3) * h, s, k3);
+    combine(s, y, h, [A41, A42, A43], [k1, k2, k3]);
+    rhs.eval(t + L::splat(C4) * h, s, k4);
+    combine(s, y, h, [A51, A52, A53, A54], [k1, k2, k3, k4]);
+    rhs.eval(t + L::splat(C5) * h, s, k5);
+    combine(s, y, h, [A61, A62, A63, A64, A65], [k1, k2, k3, k4, k5]);
+    rhs.eval(t + h, s, k6);
+    let y_new = &mut y_new[..n];
+    combine(y_new, y, h, [A71, A73, A74, A75, A76], [k1, k3, k4, k5, k6]);
+    rhs.eval(t + h, y_new, k7);
+}
+
+/// The scaled RMS of the embedded error estimate of a step `h` (s) from `y` to `y_new` with
+/// stages `k`: √(Σᵢ (eᵢ / (atol + rtol·max(|yᵢ|, |y_newᵢ|)))² / n), non-finite if the stages
+/// were. A step is accepted where it is at most 1.
+#[inline(always)]
+pub(crate) fn error_norm<L: Lane, K: AsRef<[L]>>(
+    h: L,
+    k: &[K; 7],
+    y: &[L],
+    y_new: &[L],
+    atol: L,
+    rtol: L,
+) -> L {
+    let n = y.len();
+    let [k1, _, k3, k4, k5, k6, k7] = k;
+    let (k1, k3, k4) = (&k1.as_ref()[..n], &k3.as_ref()[..n], &k4.as_ref()[..n]);
+    let (k5, k6, k7) = (&k5.as_ref()[..n], &k6.as_ref()[..n], &k7.as_ref()[..n]);
+    let y_new = &y_new[..n];
+    let c = L::splat;
+    let mut err = c(0.0);
+    for i in 0..n {
+        let e = h
+            * (c(E1) * k1[i]
+                + c(E3) * k3[i]
+                + c(E4) * k4[i]
+                + c(E5) * k5[i]
+                + c(E6) * k6[i]
+                + c(E7) * k7[i]);
+        let sc = atol + rtol * y[i].abs().max(y_new[i].abs());
+        let q = e / sc;
+        err += q * q;
+    }
+    (err / c(n as f64)).sqrt()
+}
+
+/// The dense-output coefficients of an accepted step `h` (s) from `y` to `y_new` with stages
+/// `k`, into `cont`.
+#[inline(always)]
+pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
+    h: L,
+    k: &[K; 7],
+    y: &[L],
+    y_new: &[L],
+    cont: &mut [C; 5],
+) {
+    let n = y.len();
+    let [k1, _, k3, k4, k5, k6, k7] = k;
+    let (k1, k3, k4) = (&k1.as_ref()[..n], &k3.as_ref()[..n], &k4.as_ref()[..n]);
+    let (k5, k6, k7) = (&k5.as_ref()[..n], &k6.as_ref()[..n], &k7.as_ref()[..n]);
+    let [c1, c2, c3, c4, c5] = cont;
+    let (c1, c2, c3) = (
+        &mut c1.as_mut()[..n],
+        &mut c2.as_mut()[..n],
+        &mut c3.as_mut()[..n],
+    );
+    let (c4, c5) = (&mut c4.as_mut()[..n], &mut c5.as_mut()[..n]);
+    let y_new = &y_new[..n];
+    let c = L::splat;
+    for i in 0..n {
+        let dy = y_new[i] - y[i];
+        let bspl = h * k1[i] - dy;
+        c1[i] = y[i];
+        c2[i] = dy;
+        c3[i] = bspl;
+        c4[i] = dy - h * k7[i] - bspl;
+        c5[i] = h
+            * (c(D1) * k1[i]
+                + c(D3) * k3[i]
+                + c(D4) * k4[i]
+                + c(D5) * k5[i]
+                + c(D6) * k6[i]
+                + c(D7) * k7[i]);
+    }
+}
+
+/// `err^(1/5 − 0.75 β)`, the error's factor in the step-size control, per lane (through the
+/// platform's `pow`, lane by lane).
+#[inline(always)]
+pub(crate) fn error_factor<L: Lane>(err: L) -> L {
+    err.powf(0.2 - 0.75 * BETA)
+}
+
+/// After an accepted step `h` (s) with error `err` and its factor `fac11`
+/// ([`error_factor`]): the next step by the PI controller (no longer than `h` where the step
+/// followed rejections) and the new `fac_old`.
+#[inline(always)]
+pub(crate) fn accepted_step_size<L: Lane>(
+    err: L,
+    fac11: L,
+    h: L,
+    fac_old: L,
+    after_rejections: L::Mask,
+) -> (L, L) {
+    let fac = fac11 / fac_old.powf(BETA);
+    let fac = (fac / L::splat(SAFETY)).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+    let h_new = h / fac;
+    let h_new = L::select(after_rejections, h_new.min(h), h_new);
+    (h_new, err.max(L::splat(1e-4)))
+}
+
+/// The proposal kept after an accepted step that proposes `h_new` (s): a step shortened to
+/// land on the end (`last`) does not shrink the standing `proposal`.
+#[inline(always)]
+pub(crate) fn kept_proposal<L: Lane>(last: L::Mask, proposal: L, h_new: L) -> L {
+    L::select(last, proposal.max(h_new), h_new)
+}
+
+/// The next step (s) after a rejected step `h` whose error had factor `fac11`.
+#[inline(always)]
+pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
+    h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
+}
+
+/// The next step (s) after a step `h` whose stages were not finite.
+#[inline(always)]
+pub(crate) fn non_finite_step_size<L: Lane>(h: L) -> L {
+    L::splat(0.1) * h
+}
+
+/// At most this many rejections in a row before a step fails.
+pub(crate) const MAX_REJECTIONS: u32 = MAX_REJECTIONS_IN_A_ROW;
 
 impl Stepper for Dopri5 {
     fn t(&self) -> f64 {
@@ -257,23 +436,19 @@ impl Stepper for Dopri5 {
             if !err.is_finite() {
                 saw_non_finite = true;
                 self.stats.rejected_steps += 1;
-                self.h = 0.1 * h;
+                self.h = non_finite_step_size(h);
                 rejected_in_a_row += 1;
                 if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                     return Err(StepError::NonFiniteDerivative { t: self.t });
                 }
                 continue;
             }
-            let fac11 = err.powf(0.2 - 0.75 * BETA);
+            let fac11 = error_factor(err);
             if err <= 1.0 {
                 // Accepted: PI controller for the next step.
-                let mut fac = fac11 / self.fac_old.powf(BETA);
-                fac = (fac / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                let mut h_new = h / fac;
-                if rejected_in_a_row > 0 {
-                    h_new = h_new.min(h);
-                }
-                self.fac_old = err.max(1e-4);
+                let (h_new, fac_old) =
+                    accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
+                self.fac_old = fac_old;
                 self.store_dense_output(h);
                 std::mem::swap(&mut self.y, &mut self.y_new);
                 // FSAL: the last stage is f at the new point.
@@ -282,7 +457,7 @@ impl Stepper for Dopri5 {
                 self.t = t_new;
                 self.stats.steps += 1;
                 // Keep the proposal for the next call; a shortened last step does not shrink it.
-                self.h = if last { self.h.max(h_new) } else { h_new };
+                self.h = kept_proposal(last, self.h, h_new);
                 return Ok(self.t);
             }
             self.stats.rejected_steps += 1;
@@ -290,7 +465,7 @@ impl Stepper for Dopri5 {
             if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                 return Err(StepError::StepSizeUnderflow { t: self.t, h });
             }
-            self.h = h / (1.0 / FAC_MIN).min(fac11 / SAFETY);
+            self.h = rejected_step_size(fac11, h);
         }
     }
 

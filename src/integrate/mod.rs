@@ -7,7 +7,7 @@
 //! operations.
 
 mod dop853;
-mod dopri5;
+pub(crate) mod dopri5;
 mod gauss;
 mod grid;
 pub mod jacobian;
@@ -23,6 +23,7 @@ pub use grid::FixedGrid;
 pub use radau5::Radau5;
 pub use rk4::Rk4;
 
+use crate::lanes::Lane;
 use std::fmt;
 
 /// A first-order ODE system `dy/dt = f(t, y)` of fixed dimension.
@@ -145,17 +146,17 @@ pub trait Stepper {
     fn restart<S: OdeSystem + ?Sized>(&mut self, sys: &S, y: &[f64]);
 }
 
-/// Where an adaptive step ends; see [`adaptive_step_end`].
+/// Where an adaptive step ends, per lane; see [`adaptive_step_end`].
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct StepEnd {
+pub(crate) struct StepEnd<L: Lane = f64> {
     /// End time (s).
-    pub t_new: f64,
+    pub t_new: L,
     /// Step taken, `t_new − t` (s): steps add up to the times exactly.
-    pub h: f64,
+    pub h: L,
     /// The step was stretched or cut to land exactly on `t_end`.
-    pub last: bool,
+    pub last: L::Mask,
     /// `h` is below the resolution of `t` (step-size underflow).
-    pub underflow: bool,
+    pub underflow: L::Mask,
 }
 
 /// A step no longer than this many units of `f64::EPSILON` relative to `|t|` is below the
@@ -171,22 +172,34 @@ pub const SAME_INSTANT_EPS: f64 = 4.0 * UNDERFLOW_EPS;
 /// ([`SAME_INSTANT_EPS`]) of each other, as a controller tick k·Δt and the duration m/f can be.
 /// A breakpoint within that distance of the end, or of another breakpoint, is merged with it.
 pub fn same_instant(a: f64, b: f64) -> bool {
-    (b - a).abs() <= SAME_INSTANT_EPS * f64::EPSILON * a.abs().max(b.abs())
+    same_instant_lanes(a, b)
+}
+
+/// [`same_instant`] per lane.
+#[inline(always)]
+pub(crate) fn same_instant_lanes<L: Lane>(a: L, b: L) -> L::Mask {
+    (b - a)
+        .abs()
+        .at_most(L::splat(SAME_INSTANT_EPS * f64::EPSILON) * a.abs().max(b.abs()))
 }
 
 /// Where an adaptive step of size `h_wanted` (s) from `t` ends: exactly on `t_end` when it
 /// would reach within 1e-12 of the remaining span, or within a few ulps of `t_end`
 /// ([`same_instant`]) (no sliver of a step is left that could not be taken), else at
-/// `t + h_wanted`.
-pub(crate) fn adaptive_step_end(t: f64, h_wanted: f64, t_end: f64) -> StepEnd {
-    let last = h_wanted >= (t_end - t) * (1.0 - 1e-12) || same_instant(t + h_wanted, t_end);
-    let t_new = if last { t_end } else { t + h_wanted };
+/// `t + h_wanted`. Per lane: the scalar methods call it at `f64`, the lanes at theirs.
+#[inline(always)]
+pub(crate) fn adaptive_step_end<L: Lane>(t: L, h_wanted: L, t_end: L) -> StepEnd<L> {
+    let last = h_wanted.at_least((t_end - t) * L::splat(1.0 - 1e-12))
+        | same_instant_lanes(t + h_wanted, t_end);
+    let t_new = L::select(last, t_end, t + h_wanted);
     let h = t_new - t;
     StepEnd {
         t_new,
         h,
         last,
-        underflow: h.abs() <= UNDERFLOW_EPS * f64::EPSILON * t.abs().max(1e-300),
+        underflow: h
+            .abs()
+            .at_most(L::splat(UNDERFLOW_EPS * f64::EPSILON) * t.abs().max(L::splat(1e-300))),
     }
 }
 
@@ -218,7 +231,7 @@ pub(crate) fn combine_on<const M: usize>(
         return;
     }
     let _ = avx2;
-    combine(out, base, h, a, k)
+    combine::<f64, M>(out, base, h, a, k)
 }
 
 /// [`combine`] compiled for AVX2.
@@ -231,28 +244,28 @@ fn combine_avx2<const M: usize>(
     a: [f64; M],
     k: [&[f64]; M],
 ) {
-    combine(out, base, h, a, k)
+    combine::<f64, M>(out, base, h, a, k)
 }
 
-/// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument). The slices are cut to `out.len()` first
-/// so the loops carry no bounds checks; the `M` terms are unrolled; the increments are summed
-/// before they are added to `base`, as in the textbook formula.
+/// `out = base + h·Σⱼ a[j]·k[j]` (a stage argument), per lane. The slices are cut to
+/// `out.len()` first so the loops carry no bounds checks; the `M` terms are unrolled; the
+/// increments are summed before they are added to `base`, as in the textbook formula.
 #[inline(always)]
-pub(crate) fn combine<const M: usize>(
-    out: &mut [f64],
-    base: &[f64],
-    h: f64,
+pub(crate) fn combine<L: Lane, const M: usize>(
+    out: &mut [L],
+    base: &[L],
+    h: L,
     a: [f64; M],
-    mut k: [&[f64]; M],
+    mut k: [&[L]; M],
 ) {
     let n = out.len();
     for kj in k.iter_mut() {
         *kj = &kj[..n];
     }
     for (i, o) in out.iter_mut().enumerate() {
-        let mut acc = a[0] * k[0][i];
+        let mut acc = L::splat(a[0]) * k[0][i];
         for j in 1..M {
-            acc += a[j] * k[j][i];
+            acc += L::splat(a[j]) * k[j][i];
         }
         *o = h * acc;
     }

@@ -1398,12 +1398,12 @@ fn solve_hub(c: &HubCoupling) -> HubAcceleration {
 /// `q̇ = ½ q ⊗ (0, ω)` for `q = (w, x, y, z)`, written into `dq`.
 #[inline(always)]
 pub fn quaternion_rate(q: &[f64], omega: &Vector3<f64>, dq: &mut [f64]) {
-    let (w, x, y, z) = (q[0], q[1], q[2], q[3]);
-    let (p, r, s) = (omega[0], omega[1], omega[2]);
-    dq[0] = -0.5 * (x * p + y * r + z * s);
-    dq[1] = 0.5 * (w * p + y * s - z * r);
-    dq[2] = 0.5 * (w * r + z * p - x * s);
-    dq[3] = 0.5 * (w * s + x * r - y * p);
+    // The lanes' form at f64 (one code for the scalar path and the ensembles).
+    let rate = crate::lanes::linalg::quaternion_rate([q[0], q[1], q[2], q[3]], (*omega).into());
+    dq[0] = rate[0];
+    dq[1] = rate[1];
+    dq[2] = rate[2];
+    dq[3] = rate[3];
 }
 
 impl OdeSystem for Spacecraft {

@@ -1,0 +1,555 @@
+//! The lockstep dopri5 ensemble of the nutation-damper class: a rigid hub carrying one
+//! spring–mass damper (the scalar path's `Spacecraft` with one `spring_mass_damper`, whose
+//! right-hand side is its closed form, `Spacecraft::lone_rhs`).
+//!
+//! W runs are integrated at once, one per lane ([`Lane`]): each lane has its own initial
+//! state, hub and damper parameters, end time, step size, error control, accept/reject and
+//! work counters. Every lane evaluates every stage (lockstep, as DiffEqGPU.jl's
+//! `EnsembleGPUKernel` does on GPUs: U. Utkarsh et al., "Automated translation and accelerated
+//! solving of differential equations on multiple GPU platforms", Comput. Methods Appl. Mech.
+//! Eng. 419 (2024) 116591); the decisions are taken per lane under masks. A lane whose run has
+//! ended takes the next run. The arithmetic is the scalar path's, generic over the lane
+//! (dopri5's stages, error norm and controller in `integrate::dopri5`, the damper's closed
+//! form in [`SpringMassLanes`], the quaternion rate in [`super::linalg`]), so each lane's
+//! steps, rejections, right-hand-side count and final state are bit for bit those of the
+//! scalar `Dopri5` on that run's `Spacecraft`, stepped to the same end time (the tests in
+//! tests/lanes_damper.rs compare them).
+//!
+//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2 and FMA
+//! where the processor has them ([`Engine::Avx2`]), otherwise one lane ([`Engine::Scalar`]).
+//! Not yet: events, observations and invariants, breakpoints, dense output between steps, and
+//! the campaign and Python front ends (docs/montecarlo.md, "Lanes: the foundation").
+
+use super::{F64x4, Lane, LaneMask, linalg};
+use crate::effectors::spring_mass::{SpringMass, SpringMassLanes};
+use crate::integrate::dopri5::{
+    MAX_REJECTIONS, StageRhs, accepted_step_size, error_factor, error_norm, initial_step,
+    kept_proposal, non_finite_step_size, rejected_step_size, stages,
+};
+use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+
+/// States of a run: ω (rad/s, 3), q (w, x, y, z), the damper's offset ρ (m), rate ρ̇ (m/s)
+/// and dissipated energy (J): the scalar `Spacecraft`'s layout for this scene.
+pub const DIM: usize = 10;
+
+/// One run of the class.
+#[derive(Debug, Clone)]
+pub struct DamperRun {
+    /// The hub's inertia about its centre of mass (kg m², body axes, symmetric).
+    pub hub_inertia: Matrix3<f64>,
+    /// The hub's mass (kg).
+    pub hub_mass: f64,
+    /// The damper (its `travel` is not checked here).
+    pub damper: SpringMass,
+    /// Initial body rate ω₀ (rad/s, body axes).
+    pub omega0: Vector3<f64>,
+    /// Initial attitude (body to inertial).
+    pub attitude0: UnitQuaternion<f64>,
+    /// Initial offset ρ₀ (m).
+    pub offset0: f64,
+    /// Initial offset rate ρ̇₀ (m/s).
+    pub rate0: f64,
+    /// End time (s); the run starts at t = 0.
+    pub t_end: f64,
+}
+
+impl DamperRun {
+    /// The initial state in the layout of [`DIM`] (the dissipated energy starts at 0).
+    pub fn initial_state(&self) -> [f64; DIM] {
+        let (w, q) = (self.omega0, self.attitude0);
+        [
+            w.x,
+            w.y,
+            w.z,
+            q.w,
+            q.i,
+            q.j,
+            q.k,
+            self.offset0,
+            self.rate0,
+            0.0,
+        ]
+    }
+}
+
+/// The integration settings every run of a campaign shares (as the scalar `Dopri5::new`
+/// takes them, with the first step chosen automatically).
+#[derive(Debug, Clone, Copy)]
+pub struct LaneSettings {
+    /// Tolerances of the error control.
+    pub tolerances: Tolerances,
+    /// Largest step (s); `f64::INFINITY` for none.
+    pub h_max: f64,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LaneStatus {
+    /// Reached its end time.
+    Complete,
+    /// Failed as the scalar `Dopri5::step` would have (the same error).
+    Failed(StepError),
+    /// The damper's closed form declined a state (a direction that is not a unit vector, a
+    /// 3 × 3 system that is not positive definite, a non-finite state) at time `t` (s): the
+    /// scalar path would have taken the general right-hand side there, which the lanes do not
+    /// have. Integrate this run through the scalar path.
+    Declined {
+        /// Start of the step in which it happened (s).
+        t: f64,
+    },
+}
+
+/// What a run ended with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaneOutcome {
+    /// How it ended.
+    pub status: LaneStatus,
+    /// Time reached (s).
+    pub t: f64,
+    /// State reached (layout of [`DIM`]).
+    pub y: [f64; DIM],
+    /// Work: accepted and rejected steps, right-hand-side evaluations (the rest zero).
+    pub stats: Stats,
+}
+
+/// Which compiled engine runs the lanes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Engine {
+    /// AVX2 and FMA where the processor has them, else [`Engine::Scalar`].
+    Auto,
+    /// One lane (`f64`): the same lockstep code at width 1.
+    Scalar,
+    /// Four lanes ([`F64x4`]) compiled for the baseline target (SSE2 on x86-64): for
+    /// comparison only.
+    Portable4,
+    /// Four lanes compiled for AVX2 and FMA; falls back to [`Engine::Scalar`] on a processor
+    /// without them.
+    Avx2,
+}
+
+/// Whether this processor runs [`Engine::Avx2`].
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Integrates every run to its end time with the engine chosen at run time
+/// ([`Engine::Auto`]); the outcomes are in the order of `runs`.
+pub fn integrate_runs(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
+    integrate_runs_with(Engine::Auto, runs, settings)
+}
+
+/// [`integrate_runs`] with a given engine.
+pub fn integrate_runs_with(
+    engine: Engine,
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+) -> Vec<LaneOutcome> {
+    match engine {
+        Engine::Scalar => lockstep::<f64>(runs, settings),
+        Engine::Portable4 => lockstep::<F64x4>(runs, settings),
+        Engine::Auto | Engine::Avx2 => {
+            #[cfg(target_arch = "x86_64")]
+            if avx2_available() {
+                // SAFETY: the processor has AVX2 and FMA (checked just above).
+                return unsafe { lockstep_avx2(runs, settings) };
+            }
+            lockstep::<f64>(runs, settings)
+        }
+    }
+}
+
+/// [`lockstep`] at four lanes, compiled for AVX2 and FMA (everything below is inlined into
+/// it). No `mul_add` is written, so nothing is fused: the bits are the scalar path's.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn lockstep_avx2(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
+    lockstep::<F64x4>(runs, settings)
+}
+
+/// The parameters of the runs in the lanes.
+struct System<L: Lane> {
+    damper: SpringMassLanes<L>,
+    hub_inertia: [[L; 3]; 3],
+    hub_mass: L,
+}
+
+impl<L: Lane> System<L> {
+    /// The right-hand side (the scalar `Spacecraft::lone_rhs` of this scene), per lane;
+    /// returns the lanes whose closed form was solved.
+    #[inline(always)]
+    fn rhs(&self, y: &[L], dy: &mut [L]) -> L::Mask {
+        let (y, dy) = (&y[..DIM], &mut dy[..DIM]);
+        let omega = [y[0], y[1], y[2]];
+        let (offset, rate) = (y[7], y[8]);
+        let a =
+            self.damper
+                .lone_accelerations(offset, rate, omega, &self.hub_inertia, self.hub_mass);
+        let q_dot = linalg::quaternion_rate([y[3], y[4], y[5], y[6]], omega);
+        dy[0] = a.omega_dot[0];
+        dy[1] = a.omega_dot[1];
+        dy[2] = a.omega_dot[2];
+        dy[3] = q_dot[0];
+        dy[4] = q_dot[1];
+        dy[5] = q_dot[2];
+        dy[6] = q_dot[3];
+        dy[7] = rate;
+        dy[8] = a.u_dot;
+        dy[9] = self.damper.dissipation_power(rate);
+        a.solved
+    }
+}
+
+/// The system as the stages' right-hand side, noting the lanes whose closed form was solved
+/// at every stage.
+struct Solving<'a, L: Lane> {
+    system: &'a System<L>,
+    solved: L::Mask,
+}
+
+impl<L: Lane> StageRhs<L> for Solving<'_, L> {
+    #[inline(always)]
+    fn eval(&mut self, _t: L, y: &[L], dydt: &mut [L]) {
+        self.solved = self.solved & self.system.rhs(y, dydt);
+    }
+}
+
+/// The lanes' integration state: each field holds one value per lane.
+struct Lanes<L: Lane> {
+    system: System<L>,
+    /// The shared settings, splat.
+    atol: L,
+    rtol: L,
+    h_max: L,
+    t: L,
+    t_end: L,
+    /// The controller's proposal (s).
+    h: L,
+    fac_old: L,
+    y: [L; DIM],
+    y_new: [L; DIM],
+    stage: [L; DIM],
+    k: [[L; DIM]; 7],
+    /// Work counters, as exact integers in f64.
+    steps: L,
+    rejected: L,
+    rhs_evaluations: L,
+    rejected_in_a_row: L,
+    saw_non_finite: L::Mask,
+    /// Lanes holding a run that is still stepping.
+    running: L::Mask,
+    /// Lanes that ended in the last phase, with their status, to be collected.
+    ended: Vec<(usize, LaneStatus)>,
+}
+
+impl<L: Lane> Lanes<L> {
+    /// Every lane empty, holding `run`'s values (finite, so that idle lanes compute harmless
+    /// numbers).
+    #[inline(always)]
+    fn new(run: &DamperRun, settings: &LaneSettings) -> Self {
+        let z = L::splat(0.0);
+        let mut lanes = Lanes {
+            system: System {
+                damper: SpringMassLanes {
+                    mass: z,
+                    position: [z; 3],
+                    direction: [z; 3],
+                    stiffness: z,
+                    damping: z,
+                },
+                hub_inertia: [[z; 3]; 3],
+                hub_mass: z,
+            },
+            atol: L::splat(settings.tolerances.atol),
+            rtol: L::splat(settings.tolerances.rtol),
+            h_max: L::splat(settings.h_max),
+            t: z,
+            t_end: z,
+            h: z,
+            fac_old: z,
+            y: [z; DIM],
+            y_new: [z; DIM],
+            stage: [z; DIM],
+            k: [[z; DIM]; 7],
+            steps: z,
+            rejected: z,
+            rhs_evaluations: z,
+            rejected_in_a_row: z,
+            saw_non_finite: L::Mask::splat(false),
+            running: L::Mask::splat(false),
+            ended: Vec::with_capacity(L::WIDTH),
+        };
+        for i in 0..L::WIDTH {
+            lanes.load(i, run);
+        }
+        lanes.running = L::Mask::splat(false);
+        lanes
+    }
+
+    /// Puts `run` into lane `i`, at its start.
+    #[inline(always)]
+    fn load(&mut self, i: usize, run: &DamperRun) {
+        let set = |x: &mut L, v: f64| *x = x.with_lane(i, v);
+        let d = &mut self.system.damper;
+        set(&mut d.mass, run.damper.mass);
+        set(&mut d.stiffness, run.damper.stiffness);
+        set(&mut d.damping, run.damper.damping);
+        for j in 0..3 {
+            set(&mut d.position[j], run.damper.position[j]);
+            set(&mut d.direction[j], run.damper.direction[j]);
+            for c in 0..3 {
+                set(&mut self.system.hub_inertia[c][j], run.hub_inertia[(j, c)]);
+            }
+        }
+        set(&mut self.system.hub_mass, run.hub_mass);
+        for (j, &v) in run.initial_state().iter().enumerate() {
+            set(&mut self.y[j], v);
+        }
+        set(&mut self.t, 0.0);
+        set(&mut self.t_end, run.t_end);
+        set(&mut self.h, 0.0);
+        set(&mut self.fac_old, 1e-4);
+        set(&mut self.steps, 0.0);
+        set(&mut self.rejected, 0.0);
+        set(&mut self.rhs_evaluations, 0.0);
+        set(&mut self.rejected_in_a_row, 0.0);
+        self.saw_non_finite = self.saw_non_finite.with_lane(i, false);
+        self.running = self.running.with_lane(i, true);
+    }
+
+    /// Lane `i`'s outcome with `status`.
+    fn outcome(&self, i: usize, status: LaneStatus) -> LaneOutcome {
+        LaneOutcome {
+            status,
+            t: self.t.lane(i),
+            y: std::array::from_fn(|j| self.y[j].lane(i)),
+            stats: Stats {
+                steps: self.steps.lane(i) as u64,
+                rejected_steps: self.rejected.lane(i) as u64,
+                rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
+                ..Stats::default()
+            },
+        }
+    }
+
+    /// Ends the runs of the lanes in `mask` with the status `status(i)` (kept until collected).
+    #[cold]
+    #[inline(never)]
+    fn end(&mut self, mask: L::Mask, status: impl Fn(&Self, usize) -> LaneStatus) {
+        for i in 0..L::WIDTH {
+            if mask.test(i) {
+                let s = status(self, i);
+                self.ended.push((i, s));
+                self.running = self.running.with_lane(i, false);
+            }
+        }
+    }
+
+    /// The first stage and the initial step of the lanes of `starting`, as the scalar
+    /// `Dopri5::step` does on its first call.
+    #[inline(always)]
+    fn start(&mut self, starting: L::Mask) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let system = &self.system;
+        let mut first = [zero; DIM];
+        let solved = system.rhs(&self.y, &mut first);
+        self.rhs_evaluations += L::select(starting, one, zero);
+        let mut finite = L::Mask::splat(true);
+        for (j, &f) in first.iter().enumerate() {
+            self.k[0][j] = L::select(starting, f, self.k[0][j]);
+            finite = finite & f.is_finite();
+        }
+        let declined = starting & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+        let non_finite = starting & solved & !finite;
+        if non_finite.any() {
+            self.end(non_finite, |s, i| {
+                LaneStatus::Failed(StepError::NonFiniteDerivative { t: s.t.lane(i) })
+            });
+        }
+        let starting = starting & self.running;
+        let mut rhs = Solving {
+            system: &self.system,
+            solved: L::Mask::splat(true),
+        };
+        let [k1, k2, ..] = &mut self.k;
+        let h = initial_step(
+            &mut rhs,
+            self.t,
+            &self.y,
+            k1,
+            k2,
+            &mut self.stage,
+            self.atol,
+            self.rtol,
+            self.h_max,
+            self.t_end - self.t,
+        );
+        let solved = rhs.solved;
+        self.rhs_evaluations += L::select(starting, one, zero);
+        self.h = L::select(starting, h, self.h);
+        let declined = starting & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+    }
+
+    /// One attempted step in every running lane, accepted or rejected lane by lane, as the
+    /// scalar `Dopri5::step` takes it.
+    #[inline(always)]
+    fn attempt(&mut self) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let end = adaptive_step_end(self.t, self.h.min(self.h_max), self.t_end);
+        let underflow = end.underflow & self.running;
+        if underflow.any() {
+            self.end(underflow, |s, i| {
+                let t = s.t.lane(i);
+                LaneStatus::Failed(if s.saw_non_finite.test(i) {
+                    StepError::NonFiniteDerivative { t }
+                } else {
+                    StepError::StepSizeUnderflow {
+                        t,
+                        h: (end.t_new - s.t).lane(i),
+                    }
+                })
+            });
+        }
+        let h = end.h;
+        let mut rhs = Solving {
+            system: &self.system,
+            solved: L::Mask::splat(true),
+        };
+        stages(
+            &mut rhs,
+            self.t,
+            h,
+            &self.y,
+            &mut self.k,
+            &mut self.stage,
+            &mut self.y_new,
+        );
+        let solved = rhs.solved;
+        self.rhs_evaluations += L::select(self.running, L::splat(6.0), zero);
+        let declined = self.running & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+        let running = self.running;
+        let err = error_norm(h, &self.k, &self.y, &self.y_new, self.atol, self.rtol);
+        let finite = err.is_finite();
+        let fac11 = error_factor(err);
+        let accept = running & finite & err.at_most(one);
+        let reject = running & !accept;
+        let after_rejections = self.rejected_in_a_row.greater_than(zero);
+        let (h_accepted, fac_old) =
+            accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
+        let h_rejected = L::select(
+            finite,
+            rejected_step_size(fac11, h),
+            non_finite_step_size(h),
+        );
+        self.h = L::select(
+            accept,
+            kept_proposal(end.last, self.h, h_accepted),
+            L::select(reject, h_rejected, self.h),
+        );
+        self.fac_old = L::select(accept, fac_old, self.fac_old);
+        for j in 0..DIM {
+            self.y[j] = L::select(accept, self.y_new[j], self.y[j]);
+            // First same as last: the last stage is f at the new point.
+            self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
+        }
+        self.t = L::select(accept, end.t_new, self.t);
+        self.steps += L::select(accept, one, zero);
+        self.rejected += L::select(reject, one, zero);
+        self.rejected_in_a_row = L::select(
+            accept,
+            zero,
+            L::select(reject, self.rejected_in_a_row + one, self.rejected_in_a_row),
+        );
+        self.saw_non_finite = (self.saw_non_finite & !accept) | (reject & !finite);
+        let too_many = reject
+            & self
+                .rejected_in_a_row
+                .greater_than(L::splat(f64::from(MAX_REJECTIONS)));
+        if too_many.any() {
+            self.end(too_many, |s, i| {
+                let t = s.t.lane(i);
+                LaneStatus::Failed(if finite.test(i) {
+                    StepError::StepSizeUnderflow { t, h: h.lane(i) }
+                } else {
+                    StepError::NonFiniteDerivative { t }
+                })
+            });
+        }
+        let done = accept & self.t.at_least(self.t_end);
+        if done.any() {
+            self.end(done, |_, _| LaneStatus::Complete);
+        }
+    }
+}
+
+/// The lockstep integration of `runs` at lane type `L`; see the module documentation.
+#[inline(always)]
+fn lockstep<L: Lane>(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
+    let mut outcomes: Vec<Option<LaneOutcome>> = vec![None; runs.len()];
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    let mut lanes = Lanes::<L>::new(first, settings);
+    let mut held: Vec<Option<usize>> = vec![None; L::WIDTH];
+    let mut next = 0;
+    loop {
+        // Each free lane takes the next run.
+        let mut starting = L::Mask::splat(false);
+        for (i, slot) in held.iter_mut().enumerate() {
+            while slot.is_none() && next < runs.len() {
+                let (index, run) = (next, &runs[next]);
+                next += 1;
+                let unstarted = |status| LaneOutcome {
+                    status,
+                    t: 0.0,
+                    y: run.initial_state(),
+                    stats: Stats::default(),
+                };
+                if !run.damper.has_unit_direction() {
+                    outcomes[index] = Some(unstarted(LaneStatus::Declined { t: 0.0 }));
+                } else if run.t_end.is_nan() || run.t_end <= 0.0 {
+                    // As the scalar loop `while t < t_end`: no step.
+                    outcomes[index] = Some(unstarted(LaneStatus::Complete));
+                } else {
+                    lanes.load(i, run);
+                    *slot = Some(index);
+                    starting = starting.with_lane(i, true);
+                }
+            }
+        }
+        if held.iter().all(Option::is_none) {
+            break;
+        }
+        if starting.any() {
+            lanes.start(starting);
+        }
+        if lanes.running.any() {
+            lanes.attempt();
+        }
+        for (i, status) in std::mem::take(&mut lanes.ended) {
+            if let Some(index) = held[i].take() {
+                outcomes[index] = Some(lanes.outcome(i, status));
+            }
+        }
+    }
+    outcomes
+        .into_iter()
+        .map(|o| o.expect("every run ends"))
+        .collect()
+}

@@ -1,0 +1,190 @@
+//! Lanes: the same arithmetic on one number (`f64`) or on several independent runs at once
+//! ([`F64x4`], four f64 lanes).
+//!
+//! A [`Lane`] is a value of one run (`f64`, width 1) or of W runs side by side, one per lane.
+//! Every operation acts lane by lane with the rounding of the f64 operation it names (IEEE 754
+//! binary64, round to nearest): no lane ever sees another, and no operation is contracted
+//! (Rust never fuses `a * b + c` into an FMA unless `mul_add` is written, and nothing here
+//! writes it), so a lane's result is bit for bit the result of the same code at `f64`.
+//! Decisions that differ between lanes (accept or reject a step, a lane that has finished)
+//! are taken under a [`LaneMask`] and applied with [`Lane::select`].
+//!
+//! The right-hand sides and the stepper arithmetic that the ensemble integrators share with
+//! the scalar path are written once, generic over `Lane`: at `f64` they are the code the
+//! scalar path runs (the spring–mass damper's closed form, the hub's quaternion kinematics,
+//! dopri5's stages, error norm and step-size control), at `F64x4` the code of the lanes.
+//!
+//! Layout: [`f64x4`] (the 4-wide lane and its mask), [`linalg`] (3-vectors, 3 × 3 products,
+//! the SPD inverse and the quaternion rate, in lanes), [`damper`] (the lockstep dopri5
+//! ensemble of the nutation-damper class, with the AVX2 dispatch). docs/montecarlo.md,
+//! "Lanes: the foundation", says what is tested and measured.
+
+pub mod damper;
+pub mod f64x4;
+pub mod linalg;
+
+pub use f64x4::{F64x4, M64x4};
+
+use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
+
+/// Per-lane truth values: the result of a comparison of lanes, and what [`Lane::select`]
+/// chooses by.
+pub trait LaneMask:
+    Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self> + std::fmt::Debug
+{
+    /// The same value in every lane.
+    fn splat(b: bool) -> Self;
+    /// Whether any lane is true.
+    fn any(self) -> bool;
+    /// Whether every lane is true.
+    fn all(self) -> bool;
+    /// Lane `i` (`i` < the width).
+    fn test(self, i: usize) -> bool;
+    /// A copy with lane `i` set to `b`.
+    fn with_lane(self, i: usize, b: bool) -> Self;
+}
+
+/// One f64 per lane; see the module documentation. Units are those of the quantity held.
+pub trait Lane:
+    Copy
+    + std::fmt::Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// The lanes' truth values.
+    type Mask: LaneMask;
+    /// Number of lanes.
+    const WIDTH: usize;
+    /// `x` in every lane.
+    fn splat(x: f64) -> Self;
+    /// Lane `i` (`i` < [`Lane::WIDTH`]).
+    fn lane(self, i: usize) -> f64;
+    /// A copy with lane `i` set to `x`.
+    fn with_lane(self, i: usize, x: f64) -> Self;
+    /// |x| per lane.
+    fn abs(self) -> Self;
+    /// √x per lane (correctly rounded, as `f64::sqrt`).
+    fn sqrt(self) -> Self;
+    /// `f64::max` per lane (a NaN loses to a number).
+    fn max(self, other: Self) -> Self;
+    /// `f64::min` per lane (a NaN loses to a number).
+    fn min(self, other: Self) -> Self;
+    /// `f64::clamp(lo, hi)` per lane (`lo` ≤ `hi`; NaN stays NaN).
+    fn clamp(self, lo: f64, hi: f64) -> Self;
+    /// `f64::powf(e)` per lane: the platform's `pow`, one lane at a time (not vectorised, so
+    /// that the bits are those of the scalar call).
+    fn powf(self, e: f64) -> Self;
+    /// `self < other` per lane (false where either is NaN).
+    fn less_than(self, other: Self) -> Self::Mask;
+    /// `self <= other` per lane.
+    fn at_most(self, other: Self) -> Self::Mask;
+    /// `self > other` per lane.
+    fn greater_than(self, other: Self) -> Self::Mask;
+    /// `self >= other` per lane.
+    fn at_least(self, other: Self) -> Self::Mask;
+    /// `self == other` per lane.
+    fn equals(self, other: Self) -> Self::Mask;
+    /// Finite (neither infinite nor NaN) per lane.
+    fn is_finite(self) -> Self::Mask;
+    /// `a` where `mask` is true, `b` elsewhere.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+}
+
+impl LaneMask for bool {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        b
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn test(self, _i: usize) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn with_lane(self, _i: usize, b: bool) -> Self {
+        b
+    }
+}
+
+/// Width 1: the scalar path. Each method is the f64 operation it names.
+impl Lane for f64 {
+    type Mask = bool;
+    const WIDTH: usize = 1;
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn lane(self, _i: usize) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn with_lane(self, _i: usize, x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        f64::min(self, other)
+    }
+    #[inline(always)]
+    fn clamp(self, lo: f64, hi: f64) -> Self {
+        f64::clamp(self, lo, hi)
+    }
+    #[inline(always)]
+    fn powf(self, e: f64) -> Self {
+        f64::powf(self, e)
+    }
+    #[inline(always)]
+    fn less_than(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn at_most(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn greater_than(self, other: Self) -> bool {
+        self > other
+    }
+    #[inline(always)]
+    fn at_least(self, other: Self) -> bool {
+        self >= other
+    }
+    #[inline(always)]
+    fn equals(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+}

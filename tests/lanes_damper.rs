@@ -1,0 +1,255 @@
+//! The lockstep lanes of the nutation-damper class against the scalar path, bit for bit.
+//!
+//! The reference is the scalar `Dopri5` on a `Spacecraft` built the normal way (a hub with a
+//! `spring_mass_damper` effector, whose right-hand side is its nalgebra closed form), stepped to
+//! each run's end time. Each lane must give the same accepted and rejected steps, right-hand-side
+//! evaluations, final time and final state, to the bit, on every engine (one lane, four lanes
+//! compiled for the baseline target, four lanes compiled for AVX2).
+//!
+//!   cargo test --release --test lanes_damper
+//!   cargo test --release --test lanes_damper -- --ignored --nocapture   # the runs/s figures
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use polhode::effectors::particles::ParticleEffector;
+use polhode::effectors::spring_mass::SpringMass;
+use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
+use polhode::lanes::damper::{
+    DamperRun, Engine, LaneOutcome, LaneSettings, LaneStatus, avx2_available, integrate_runs,
+    integrate_runs_with,
+};
+use polhode::model::{RigidBody, Spacecraft};
+use std::time::Instant;
+
+/// The scenario's tolerances (scenarios/nutation-damper.yaml).
+const SETTINGS: LaneSettings = LaneSettings {
+    tolerances: Tolerances {
+        rtol: 1e-11,
+        atol: 1e-13,
+    },
+    h_max: f64::INFINITY,
+};
+
+/// A small deterministic generator (splitmix64), so the draws need no seed plumbing.
+struct Draws(u64);
+
+impl Draws {
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        lo + (hi - lo) * (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `count` runs of scenarios/nutation-damper.yaml with dispersed products of inertia, ω₀,
+/// attitude, damper state and damper mass, stiffness and damping, ending at `t_end(i)`.
+fn dispersed_runs(count: usize, seed: u64, t_end: impl Fn(usize) -> f64) -> Vec<DamperRun> {
+    let mut d = Draws(seed);
+    (0..count)
+        .map(|i| DamperRun {
+            hub_inertia: {
+                // Products of inertia too, so that every entry of the matrix is read.
+                let (xy, xz, yz) = (
+                    d.uniform(-8.0, 8.0),
+                    d.uniform(-8.0, 8.0),
+                    d.uniform(-8.0, 8.0),
+                );
+                Matrix3::new(1375.7, xy, xz, xy, 1292.5, yz, xz, yz, 1402.4)
+            },
+            hub_mass: 5274.4,
+            damper: SpringMass {
+                mass: 52.744 * d.uniform(0.8, 1.2),
+                position: Vector3::new(1.0, 0.0, 0.0),
+                direction: Vector3::z(),
+                stiffness: 52.744 * d.uniform(0.5, 1.5),
+                damping: 105.49 * d.uniform(0.2, 3.0),
+                travel: None,
+            },
+            omega0: Vector3::new(
+                d.uniform(0.02, 0.2),
+                d.uniform(-0.05, 0.05),
+                d.uniform(0.8, 1.2),
+            ),
+            attitude0: UnitQuaternion::from_euler_angles(
+                d.uniform(-0.3, 0.3),
+                d.uniform(-0.3, 0.3),
+                d.uniform(-3.0, 3.0),
+            ),
+            offset0: d.uniform(-0.05, 0.05),
+            rate0: d.uniform(-0.02, 0.02),
+            t_end: t_end(i),
+        })
+        .collect()
+}
+
+/// The run's spacecraft, built as the scenario loader builds it.
+fn spacecraft(run: &DamperRun) -> Spacecraft {
+    let mut sc = Spacecraft::new(RigidBody::new(run.hub_inertia).unwrap(), Vector3::z());
+    sc.hub_mass = Some(run.hub_mass);
+    let damper = ParticleEffector::new("damper", run.damper.clone(), &[run.offset0], &[run.rate0]);
+    sc.add_effector(Box::new(damper)).unwrap();
+    sc
+}
+
+/// The scalar path: `Dopri5` on the run's `Spacecraft`, stepped to its end time.
+fn scalar(run: &DamperRun) -> (f64, Vec<f64>, Stats) {
+    let sc = spacecraft(run);
+    let y0 = sc.initial_state(&run.omega0, &run.attitude0);
+    assert_eq!(y0, run.initial_state().to_vec(), "state layouts differ");
+    let mut s = Dopri5::new(0.0, &y0, SETTINGS.tolerances, SETTINGS.h_max, None);
+    while s.t() < run.t_end {
+        s.step(&sc, run.t_end).expect("the scalar run completes");
+    }
+    (s.t(), s.y().to_vec(), s.stats())
+}
+
+fn assert_bitwise_equal(engine: Engine, runs: &[DamperRun], lanes: &[LaneOutcome]) {
+    assert_eq!(lanes.len(), runs.len());
+    for (i, (run, lane)) in runs.iter().zip(lanes).enumerate() {
+        let (t, y, stats) = scalar(run);
+        assert_eq!(lane.status, LaneStatus::Complete, "{engine:?}, run {i}");
+        assert_eq!(lane.stats, stats, "{engine:?}, run {i}: work");
+        assert_eq!(lane.t.to_bits(), t.to_bits(), "{engine:?}, run {i}: t");
+        for (j, (a, b)) in lane.y.iter().zip(&y).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "{engine:?}, run {i}, state {j}: {a} vs {b}"
+            );
+        }
+    }
+}
+
+fn engines() -> Vec<Engine> {
+    let mut e = vec![Engine::Scalar, Engine::Portable4];
+    if avx2_available() {
+        e.push(Engine::Avx2);
+    }
+    e
+}
+
+/// 12 dispersed draws to 60 s, all ending together: three full lanes of four.
+#[test]
+fn lanes_equal_the_scalar_runs_bit_for_bit() {
+    let runs = dispersed_runs(12, 1958, |_| 60.0);
+    for engine in engines() {
+        assert_bitwise_equal(
+            engine,
+            &runs,
+            &integrate_runs_with(engine, &runs, &SETTINGS),
+        );
+    }
+}
+
+/// 10 draws ending at different times (10 to 100 s, not in order): lanes finish apart, are
+/// refilled with the next run, and the last group is not full.
+#[test]
+fn lanes_that_end_at_different_times_equal_the_scalar_runs() {
+    let ends = [37.0, 10.0, 100.0, 55.5, 23.25, 80.0, 12.0, 64.0, 99.9, 41.0];
+    let runs = dispersed_runs(10, 7, |i| ends[i]);
+    for engine in engines() {
+        assert_bitwise_equal(
+            engine,
+            &runs,
+            &integrate_runs_with(engine, &runs, &SETTINGS),
+        );
+    }
+}
+
+/// A loose tolerance makes the controller reject steps; the rejections match too.
+#[test]
+fn rejected_steps_match_the_scalar_runs() {
+    let loose = LaneSettings {
+        tolerances: Tolerances {
+            rtol: 1e-3,
+            atol: 1e-6,
+        },
+        h_max: f64::INFINITY,
+    };
+    let runs: Vec<DamperRun> = dispersed_runs(8, 99, |i| 20.0 + 7.0 * i as f64)
+        .into_iter()
+        .map(|mut r| {
+            r.omega0 *= 3.0;
+            r
+        })
+        .collect();
+    let mut rejected = 0;
+    for engine in engines() {
+        let lanes = integrate_runs_with(engine, &runs, &loose);
+        for (run, lane) in runs.iter().zip(&lanes) {
+            let sc = spacecraft(run);
+            let y0 = sc.initial_state(&run.omega0, &run.attitude0);
+            let mut s = Dopri5::new(0.0, &y0, loose.tolerances, loose.h_max, None);
+            while s.t() < run.t_end {
+                s.step(&sc, run.t_end).unwrap();
+            }
+            assert_eq!(lane.stats, s.stats());
+            assert_eq!(lane.y.to_vec(), s.y().to_vec());
+            rejected += s.stats().rejected_steps;
+        }
+    }
+    assert!(
+        rejected > 0,
+        "no step was rejected: the test does not test rejections"
+    );
+}
+
+/// A direction that is not a unit vector is declined (the scalar path takes its general form
+/// there), and a run that ends at its start takes no step; the other runs are unaffected.
+#[test]
+fn declined_and_empty_runs_are_reported() {
+    let mut runs = dispersed_runs(5, 31, |_| 5.0);
+    runs[1].damper.direction = Vector3::new(0.0, 0.6, 0.6);
+    runs[3].t_end = 0.0;
+    let lanes = integrate_runs(&runs, &SETTINGS);
+    assert_eq!(lanes[1].status, LaneStatus::Declined { t: 0.0 });
+    assert_eq!(lanes[3].status, LaneStatus::Complete);
+    assert_eq!(lanes[3].stats, Stats::default());
+    for i in [0, 2, 4] {
+        let (_, y, stats) = scalar(&runs[i]);
+        assert_eq!(lanes[i].stats, stats);
+        assert_eq!(lanes[i].y.to_vec(), y);
+    }
+}
+
+/// Runs per second of the lane engines against the plain scalar loop over the same draws, in
+/// this process (the scenario's 600 s, rtol 1e-11, atol 1e-13). Prints; asserts nothing about
+/// time.
+#[test]
+#[ignore]
+fn bench_lanes_against_the_scalar_loop() {
+    let runs = dispersed_runs(32, 2024, |_| 600.0);
+    let repeats = 3;
+    let time = |f: &mut dyn FnMut()| {
+        (0..repeats)
+            .map(|_| {
+                let start = Instant::now();
+                f();
+                start.elapsed().as_secs_f64()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let scalar_loop = time(&mut || {
+        for run in &runs {
+            std::hint::black_box(scalar(run));
+        }
+    });
+    let rate = |t: f64| runs.len() as f64 / t;
+    println!(
+        "{} runs of 600 s: scalar Dopri5 loop {:.1} runs/s",
+        runs.len(),
+        rate(scalar_loop)
+    );
+    for engine in engines() {
+        let t = time(&mut || {
+            std::hint::black_box(integrate_runs_with(engine, &runs, &SETTINGS));
+        });
+        println!(
+            "  {engine:?}: {:.1} runs/s, {:.2}x the scalar loop",
+            rate(t),
+            scalar_loop / t
+        );
+    }
+}
