@@ -63,26 +63,24 @@ row() {
     echo "| $what | $unit | $base | $this | $ratio ($low–$high) |"
 }
 
+# Paired figures, "this baseline" a line, of MEASURE (runs_per_second or wall_seconds) on
+# each build in turn, with the rest of the arguments.
+paired() {
+    local measure=$1
+    shift
+    for _ in $(seq "$repeats"); do
+        local b a
+        b=$("$measure" "$baseline" "$@")
+        a=$("$measure" "$candidate" "$@")
+        echo "$a $b"
+    done
+}
+
 echo "| figure | unit | baseline | this build | this / baseline, paired median (range) |"
 echo "|---|---|---:|---:|---:|"
-figures=""
-for _ in $(seq "$repeats"); do
-    b=$(runs_per_second "$baseline" scenarios/nutation-damper.yaml --runs "${RUNS:-200}")
-    a=$(runs_per_second "$candidate" scenarios/nutation-damper.yaml --runs "${RUNS:-200}")
-    figures+="$a $b"$'\n'
-done
-row "nutation-damper campaign, ${RUNS:-200} runs, 1 thread" "runs/s" "$figures"
-figures=""
-for _ in $(seq "$repeats"); do
-    b=$(runs_per_second "$baseline" scenarios/explorer1-pydy.yaml --runs "${PYDY_RUNS:-16}")
-    a=$(runs_per_second "$candidate" scenarios/explorer1-pydy.yaml --runs "${PYDY_RUNS:-16}")
-    figures+="$a $b"$'\n'
-done
-row "explorer1-pydy campaign, ${PYDY_RUNS:-16} runs, 1 thread" "runs/s" "$figures"
-figures=""
-for _ in $(seq "$repeats"); do
-    b=$(wall_seconds "$baseline" run scenarios/explorer1.yaml --no-log -q)
-    a=$(wall_seconds "$candidate" run scenarios/explorer1.yaml --no-log -q)
-    figures+="$a $b"$'\n'
-done
-row "main job (explorer1.yaml --no-log)" "s" "$figures"
+row "nutation-damper campaign, ${RUNS:-200} runs, 1 thread" "runs/s" \
+    "$(paired runs_per_second scenarios/nutation-damper.yaml --runs "${RUNS:-200}")"
+row "explorer1-pydy campaign, ${PYDY_RUNS:-16} runs, 1 thread" "runs/s" \
+    "$(paired runs_per_second scenarios/explorer1-pydy.yaml --runs "${PYDY_RUNS:-16}")"
+row "main job (explorer1.yaml --no-log)" "s" \
+    "$(paired wall_seconds run scenarios/explorer1.yaml --no-log -q)"
