@@ -15,8 +15,8 @@
 //! scalar `Dopri5` on that run's `Spacecraft`, stepped to the same end time (the tests in
 //! tests/lanes_damper.rs compare them).
 //!
-//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2
-//! where the processor has it ([`Engine::Avx2`]), otherwise one lane ([`Engine::Scalar`]).
+//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2 and FMA
+//! where the processor has them ([`Engine::Avx2`]), otherwise one lane ([`Engine::Scalar`]).
 //! Not yet: events, observations and invariants, breakpoints, dense output between steps, and
 //! the campaign and Python front ends (docs/montecarlo.md, "Lanes: the foundation").
 
@@ -116,16 +116,28 @@ pub struct LaneOutcome {
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Engine {
-    /// AVX2 where the processor has it, else [`Engine::Scalar`].
+    /// AVX2 and FMA where the processor has them, else [`Engine::Scalar`].
     Auto,
     /// One lane (`f64`): the same lockstep code at width 1.
     Scalar,
     /// Four lanes ([`F64x4`]) compiled for the baseline target (SSE2 on x86-64): for
     /// comparison only.
     Portable4,
-    /// Four lanes compiled for AVX2; falls back to [`Engine::Scalar`] on a processor
-    /// without it.
+    /// Four lanes compiled for AVX2 and FMA; falls back to [`Engine::Scalar`] on a processor
+    /// without them.
     Avx2,
+}
+
+/// Whether this processor runs [`Engine::Avx2`].
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
 }
 
 /// Integrates every run to its end time with the engine chosen at run time
@@ -145,8 +157,8 @@ pub fn integrate_runs_with(
         Engine::Portable4 => lockstep::<F64x4>(runs, settings),
         Engine::Auto | Engine::Avx2 => {
             #[cfg(target_arch = "x86_64")]
-            if crate::cpu::avx2_available() {
-                // SAFETY: the processor has AVX2 (checked just above).
+            if avx2_available() {
+                // SAFETY: the processor has AVX2 and FMA (checked just above).
                 return unsafe { lockstep_avx2(runs, settings) };
             }
             lockstep::<f64>(runs, settings)
@@ -154,11 +166,10 @@ pub fn integrate_runs_with(
     }
 }
 
-/// [`lockstep`] at four lanes, compiled for AVX2 (everything below is inlined into it). No
-/// `mul_add` is written and FMA is not enabled, so nothing is fused: the bits are the scalar
-/// path's.
+/// [`lockstep`] at four lanes, compiled for AVX2 and FMA (everything below is inlined into
+/// it). No `mul_add` is written, so nothing is fused: the bits are the scalar path's.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 unsafe fn lockstep_avx2(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
     lockstep::<F64x4>(runs, settings)
 }
