@@ -34,17 +34,21 @@ class Campaign:
     - ``summary``: the ``summary.json`` document as a dict (statistics, event probabilities
       with 95 % intervals, ranking, failures);
     - ``parquet``: the ``runs.parquet`` bytes, as ``polhode montecarlo`` writes them;
-    - ``partial``: whether runs of the range are missing (the campaign was interrupted).
+    - ``partial``: whether runs of the range are missing (the campaign was interrupted);
+    - ``integration``: how the runs were integrated, as ``polhode montecarlo``'s header says
+      it (in lockstep lanes, or one at a time per thread and why).
     """
 
     parquet: bytes
     summary: dict
     partial: bool
+    integration: str
 
-    def __init__(self, parquet: bytes, summary: dict, partial: bool) -> None:
+    def __init__(self, parquet: bytes, summary: dict, partial: bool, integration: str = "") -> None:
         self.parquet = parquet
         self.summary = summary
         self.partial = partial
+        self.integration = integration
         self._table = None
 
     @property
@@ -178,6 +182,7 @@ def montecarlo(
     shard: Union[str, Tuple[int, int], None] = None,
     progress: Union[bool, None, Callable[[int, int], Any]] = None,
     method: Optional[str] = None,
+    lanes: bool = True,
 ) -> Campaign:
     """Run the scenario's Monte Carlo campaign (its ``montecarlo:`` block) in process.
 
@@ -194,6 +199,9 @@ def montecarlo(
       every 0.1 s while the count changes.
     - ``method``: every run's integration method instead of the scenario's, as ``--method``
       (e.g. ``"averaged"``, docs/averaging.md).
+    - ``lanes``: False integrates one run after another on each thread even where the scene
+      has a lane form, as ``--no-lanes`` (the rows are the same; docs/montecarlo.md). The
+      returned campaign's ``integration`` says which path ran.
 
     Returns a :class:`Campaign`. The GIL is released while the runs go. Ctrl-C stops the
     campaign within a fraction of a second and raises ``KeyboardInterrupt`` whose
@@ -218,17 +226,19 @@ def montecarlo(
         raise type_error(
             "montecarlo", "method", "an integration method's name (str, e.g. \"averaged\")", method
         )
+    if not isinstance(lanes, bool):
+        raise type_error("montecarlo", "lanes", "True or False (bool)", lanes)
     pair = _shard(shard)
     name = getattr(scenario, "name", "montecarlo")
     report = _progress(progress, name)
     try:
-        parquet, summary, partial, raised = _montecarlo(
-            scenario, runs, seed, threads, pair, report, method
+        parquet, summary, partial, raised, integration = _montecarlo(
+            scenario, runs, seed, threads, pair, report, method, lanes
         )
     finally:
         if isinstance(report, _Bar):
             report.close()
-    campaign = Campaign(parquet, json.loads(summary), partial)
+    campaign = Campaign(parquet, json.loads(summary), partial, integration)
     if raised is not None:
         raised.partial = campaign
         raise raised

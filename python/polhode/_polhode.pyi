@@ -162,9 +162,11 @@ def _montecarlo(
     shard: Optional[Tuple[int, int]] = None,
     on_progress: Optional[Callable[[int, int], object]] = None,
     method: Optional[str] = None,
-) -> Tuple[bytes, str, bool, Optional[BaseException]]:
+    lanes: bool = True,
+) -> Tuple[bytes, str, bool, Optional[BaseException], str]:
     """Internal: see :func:`polhode.montecarlo`. Returns the ``runs.parquet`` bytes, the
-    ``summary.json`` text, whether runs are missing, and the exception raised meanwhile."""
+    ``summary.json`` text, whether runs are missing, the exception raised meanwhile, and how
+    the runs were integrated."""
 
 def load(path: Union[str, "PathLike[str]"]) -> Scenario:
     """Read and validate a scenario file (YAML); raises ScenarioError, or TypeError when

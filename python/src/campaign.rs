@@ -13,11 +13,12 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 /// Runs a Monte Carlo campaign in process (`polhode.montecarlo` wraps it): the runs of the
 /// range, the `runs.parquet` bytes and `summary.json` text `polhode montecarlo` writes for
-/// them, whether runs are missing, and the exception raised meanwhile (Ctrl-C), if any.
+/// them, whether runs are missing, the exception raised meanwhile (Ctrl-C), if any, and how
+/// the runs were integrated (`lanes`: in lanes where the scene has a lane form).
 /// `on_progress(done, total)` is called from this thread: once before, then on the 0.1 s
 /// wake-ups when the count changed, and once at the end.
 #[pyfunction]
-#[pyo3(signature = (scenario, runs=None, seed=None, threads=None, shard=None, on_progress=None, method=None))]
+#[pyo3(signature = (scenario, runs=None, seed=None, threads=None, shard=None, on_progress=None, method=None, lanes=true))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 pub(crate) fn _montecarlo(
     py: Python<'_>,
@@ -28,11 +29,16 @@ pub(crate) fn _montecarlo(
     shard: Option<(u64, u64)>,
     on_progress: Option<Bound<'_, PyAny>>,
     method: Option<String>,
-) -> PyResult<(Py<PyBytes>, String, bool, Option<Py<PyAny>>)> {
+    lanes: bool,
+) -> PyResult<(Py<PyBytes>, String, bool, Option<Py<PyAny>>, String)> {
     let (path, source) = (scenario.path.clone(), scenario.source.clone());
     let prepared = catch_unwind(AssertUnwindSafe(|| {
         let s = scenario::parse(&path, source, &Overrides::default())?;
-        montecarlo::Prepared::new(s, &path.display().to_string(), runs, seed)?.with_method(method)
+        Ok::<_, polhode::scenario::ScenarioError>(
+            montecarlo::Prepared::new(s, &path.display().to_string(), runs, seed)?
+                .with_method(method)?
+                .with_integration(lanes),
+        )
     }))
     .map_err(|p| internal_error("preparing the campaign", p.as_ref()))?;
     let prep = prepared.map_err(|e| scenario_error(py, &e))?;
@@ -104,5 +110,6 @@ pub(crate) fn _montecarlo(
         summary,
         partial,
         raised,
+        prep.integration.describe(),
     ))
 }

@@ -18,8 +18,12 @@ SINK = REPO / "tests/data/montecarlo-sink.yaml"
 
 
 def cli_campaign(polhode_cli, out, *options):
+    return cli_campaign_of(polhode_cli, SINK, out, *options)
+
+
+def cli_campaign_of(polhode_cli, scenario, out, *options):
     subprocess.run(
-        [str(polhode_cli), "montecarlo", str(SINK), "--quiet", "--out", str(out)] + list(options),
+        [str(polhode_cli), "montecarlo", str(scenario), "--quiet", "--out", str(out)] + list(options),
         check=True,
         cwd=REPO,
     )
@@ -69,6 +73,26 @@ def test_the_averaged_method_equals_the_cli_with_method(polhode_cli, tmp_path):
     assert campaign.table.column("steps").to_pylist() != full.table.column("steps").to_pylist()
     with pytest.raises(polhode.ScenarioError, match="unknown method"):
         polhode.montecarlo(polhode.load(SINK), runs=4, method="avergaed")
+
+
+DAMPER = REPO / "scenarios/nutation-damper.yaml"
+
+
+def test_a_damper_campaign_runs_in_lanes_with_the_scalar_rows(polhode_cli, tmp_path):
+    lanes = polhode.montecarlo(polhode.load(DAMPER), runs=12, seed=5, threads=2)
+    assert lanes.integration.startswith("in lockstep lane"), lanes.integration
+    scalar = polhode.montecarlo(polhode.load(DAMPER), runs=12, seed=5, threads=1, lanes=False)
+    assert scalar.integration.startswith("one run at a time"), scalar.integration
+    assert lanes.parquet == scalar.parquet
+    out = cli_campaign_of(polhode_cli, DAMPER, tmp_path / "damper", "--seed", "5", "--runs", "12")
+    assert lanes.parquet == (out / "runs.parquet").read_bytes()
+    with pytest.raises(TypeError, match="lanes"):
+        polhode.montecarlo(polhode.load(DAMPER), runs=2, lanes="no")
+
+
+def test_a_scene_without_a_lane_form_says_why():
+    campaign = polhode.montecarlo(polhode.load(SINK), runs=2)
+    assert "no lane form" in campaign.integration, campaign.integration
 
 
 def test_to_pandas_is_the_table():

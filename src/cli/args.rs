@@ -128,6 +128,10 @@ pub(super) enum Command {
         /// Integration method of every run instead of the scenario's (e.g. `averaged`).
         #[arg(long)]
         method: Option<String>,
+        /// Integrate one run after another on each thread even where the scene has a lane
+        /// form (the rows are the same; for comparison).
+        #[arg(long)]
+        no_lanes: bool,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,

@@ -114,6 +114,7 @@ pub fn main() -> i32 {
             shard,
             out,
             method,
+            no_lanes,
             quiet,
         } => montecarlo::montecarlo_cmd(
             &scenario,
@@ -124,6 +125,7 @@ pub fn main() -> i32 {
                 shard: shard.as_deref(),
                 out,
                 method,
+                lanes: !no_lanes,
                 quiet,
             },
         ),

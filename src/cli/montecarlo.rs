@@ -35,6 +35,8 @@ pub(super) struct Options<'a> {
     pub(super) shard: Option<&'a str>,
     pub(super) out: Option<PathBuf>,
     pub(super) method: Option<String>,
+    /// Lanes where the scene has a lane form (`--no-lanes` clears it).
+    pub(super) lanes: bool,
     pub(super) quiet: bool,
 }
 
@@ -48,10 +50,11 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         shard,
         out,
         method,
+        lanes,
         quiet,
     } = options;
     let prep = match montecarlo::load_with_method(path, runs, seed, method) {
-        Ok(p) => p,
+        Ok(p) => p.with_integration(lanes),
         Err(e) => {
             eprintln!("error: {e}");
             return EXIT_BAD_INPUT;
@@ -126,12 +129,13 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
     let total = range.end - range.start;
     if !quiet {
         eprintln!(
-            "{}: {} runs{} on {threads} thread(s), seed {} → {}",
+            "{}: {} runs{} on {threads} thread(s), seed {} → {}\n  integrated {}",
             prep.scenario.name,
             total,
             shard.map_or(String::new(), |[k, n]| format!(" (shard {k} of {n})")),
             prep.campaign.seed,
-            dir.display()
+            dir.display(),
+            prep.integration.describe()
         );
     }
     let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {

@@ -339,6 +339,42 @@ pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
     }
 }
 
+/// The dense output at `t` (s) of the accepted step from `t_prev` to `t_now` that ended at
+/// `y_now`, from its coefficients `cont` ([`dense_coefficients`]), into `out`. The step's ends
+/// are returned as stored.
+#[inline(always)]
+pub(crate) fn dense_value<C: AsRef<[f64]>>(
+    t: f64,
+    t_prev: f64,
+    t_now: f64,
+    y_now: &[f64],
+    cont: &[C; 5],
+    out: &mut [f64],
+) {
+    let h = t_now - t_prev;
+    if h == 0.0 || t == t_now {
+        out.copy_from_slice(y_now);
+        return;
+    }
+    if t == t_prev {
+        out.copy_from_slice(cont[0].as_ref());
+        return;
+    }
+    let th = (t - t_prev) / h;
+    let th1 = 1.0 - th;
+    let [c1, c2, c3, c4, c5] = cont;
+    let (c1, c2, c3, c4, c5) = (
+        c1.as_ref(),
+        c2.as_ref(),
+        c3.as_ref(),
+        c4.as_ref(),
+        c5.as_ref(),
+    );
+    for i in 0..out.len() {
+        out[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
+    }
+}
+
 /// `err^(1/5 − 0.75 β)`, the error's factor in the step-size control, per lane (through the
 /// platform's `pow`, lane by lane).
 #[inline(always)]
@@ -476,22 +512,7 @@ impl Stepper for Dopri5 {
     }
 
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
-        // The step's ends are returned as stored.
-        if h == 0.0 || t == self.t {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        if t == self.t_prev {
-            out.copy_from_slice(&self.cont[0]);
-            return;
-        }
-        let th = (t - self.t_prev) / h;
-        let th1 = 1.0 - th;
-        let [c1, c2, c3, c4, c5] = &self.cont;
-        for i in 0..out.len() {
-            out[i] = c1[i] + th * (c2[i] + th1 * (c3[i] + th * (c4[i] + th1 * c5[i])));
-        }
+        dense_value(t, self.t_prev, self.t, &self.y, &self.cont, out);
     }
 }
 

@@ -17,14 +17,16 @@
 //!
 //! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2 and FMA
 //! where the processor has them ([`Engine::Avx2`]), otherwise one lane ([`Engine::Scalar`]).
-//! Not yet: events, observations and invariants, breakpoints, dense output between steps, and
-//! the campaign and Python front ends (docs/montecarlo.md, "Lanes: the foundation").
+//! [`integrate_runs_observed`] also hands each accepted step of each lane, with its dense
+//! output, to an observer that may end the run: the campaigns' run monitor (samples, events,
+//! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
+//! here: breakpoints (a scene with one does not take this class).
 
 use super::{F64x4, Lane, LaneMask, linalg};
 use crate::effectors::spring_mass::{SpringMass, SpringMassLanes};
 use crate::integrate::dopri5::{
-    MAX_REJECTIONS, StageRhs, accepted_step_size, error_factor, error_norm, initial_step,
-    kept_proposal, non_finite_step_size, rejected_step_size, stages,
+    MAX_REJECTIONS, StageRhs, accepted_step_size, dense_coefficients, error_factor, error_norm,
+    initial_step, kept_proposal, non_finite_step_size, rejected_step_size, stages,
 };
 use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -98,6 +100,44 @@ pub enum LaneStatus {
         /// Start of the step in which it happened (s).
         t: f64,
     },
+    /// Ended by the observer of [`integrate_runs_observed`] after an accepted step (a
+    /// terminal event, a failed check, an interrupt).
+    Ended,
+}
+
+/// An accepted step of one lane, as [`integrate_runs_observed`] hands it to its observer: the
+/// step's ends and the coefficients of its dense output (those of the scalar `Dopri5`).
+#[derive(Debug, Clone)]
+pub struct LaneStep {
+    /// Start of the step (s).
+    pub t_prev: f64,
+    /// End of the step (s).
+    pub t: f64,
+    /// State at the end of the step (layout of [`DIM`]).
+    pub y: [f64; DIM],
+    /// Dense-output coefficients of the step.
+    pub cont: [[f64; DIM]; 5],
+    /// Work so far: accepted and rejected steps, right-hand-side evaluations.
+    pub stats: Stats,
+}
+
+impl LaneStep {
+    /// The state at `t` (s) in the step, from its dense output (as the scalar `Dopri5`
+    /// interpolates).
+    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
+        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, &self.y, &self.cont, out);
+    }
+
+    /// The step view of a run's end (`outcome`): its state, with no step to interpolate in.
+    pub fn at_end(outcome: &LaneOutcome) -> Self {
+        LaneStep {
+            t_prev: outcome.t,
+            t: outcome.t,
+            y: outcome.y,
+            cont: [[0.0; DIM]; 5],
+            stats: outcome.stats,
+        }
+    }
 }
 
 /// What a run ended with.
@@ -112,6 +152,10 @@ pub struct LaneOutcome {
     /// Work: accepted and rejected steps, right-hand-side evaluations (the rest zero).
     pub stats: Stats,
 }
+
+/// What [`integrate_runs_observed`] calls after each accepted step of a run: `(run, step)`,
+/// the run's index and its step; false ends the run there.
+pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep) -> bool;
 
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -152,17 +196,53 @@ pub fn integrate_runs_with(
     runs: &[DamperRun],
     settings: &LaneSettings,
 ) -> Vec<LaneOutcome> {
+    run_engine(engine, runs, settings, None)
+}
+
+/// [`integrate_runs`], handing every accepted step of every run to `observe(run, step)` (the
+/// run's index in `runs`); when it returns false, the run ends there with
+/// [`LaneStatus::Ended`].
+pub fn integrate_runs_observed(
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    observe: &mut dyn FnMut(usize, &LaneStep) -> bool,
+) -> Vec<LaneOutcome> {
+    run_engine(Engine::Auto, runs, settings, Some(observe))
+}
+
+/// [`integrate_runs_observed`] with a given engine.
+pub fn integrate_runs_observed_with(
+    engine: Engine,
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    observe: &mut dyn FnMut(usize, &LaneStep) -> bool,
+) -> Vec<LaneOutcome> {
+    run_engine(engine, runs, settings, Some(observe))
+}
+
+/// The engine actually run for `engine` on this processor.
+pub fn resolved(engine: Engine) -> Engine {
     match engine {
-        Engine::Scalar => lockstep::<f64>(runs, settings),
-        Engine::Portable4 => lockstep::<F64x4>(runs, settings),
-        Engine::Auto | Engine::Avx2 => {
-            #[cfg(target_arch = "x86_64")]
-            if avx2_available() {
-                // SAFETY: the processor has AVX2 and FMA (checked just above).
-                return unsafe { lockstep_avx2(runs, settings) };
-            }
-            lockstep::<f64>(runs, settings)
+        Engine::Auto | Engine::Avx2 if avx2_available() => Engine::Avx2,
+        Engine::Auto | Engine::Avx2 => Engine::Scalar,
+        e => e,
+    }
+}
+
+fn run_engine(
+    engine: Engine,
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    observe: Option<Observer<'_>>,
+) -> Vec<LaneOutcome> {
+    match resolved(engine) {
+        Engine::Portable4 => lockstep::<F64x4>(runs, settings, observe),
+        #[cfg(target_arch = "x86_64")]
+        Engine::Avx2 => {
+            // SAFETY: `resolved` chose AVX2 only where the processor has AVX2 and FMA.
+            unsafe { lockstep_avx2(runs, settings, observe) }
         }
+        _ => lockstep::<f64>(runs, settings, observe),
     }
 }
 
@@ -170,8 +250,12 @@ pub fn integrate_runs_with(
 /// it). No `mul_add` is written, so nothing is fused: the bits are the scalar path's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn lockstep_avx2(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
-    lockstep::<F64x4>(runs, settings)
+unsafe fn lockstep_avx2(
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    observe: Option<Observer<'_>>,
+) -> Vec<LaneOutcome> {
+    lockstep::<F64x4>(runs, settings, observe)
 }
 
 /// The parameters of the runs in the lanes.
@@ -229,6 +313,8 @@ struct Lanes<L: Lane> {
     rtol: L,
     h_max: L,
     t: L,
+    /// Start of the last accepted step (s), when observed.
+    t_prev: L,
     t_end: L,
     /// The controller's proposal (s).
     h: L,
@@ -237,6 +323,8 @@ struct Lanes<L: Lane> {
     y_new: [L; DIM],
     stage: [L; DIM],
     k: [[L; DIM]; 7],
+    /// Dense-output coefficients of the last accepted step, when observed.
+    cont: [[L; DIM]; 5],
     /// Work counters, as exact integers in f64.
     steps: L,
     rejected: L,
@@ -271,6 +359,7 @@ impl<L: Lane> Lanes<L> {
             rtol: L::splat(settings.tolerances.rtol),
             h_max: L::splat(settings.h_max),
             t: z,
+            t_prev: z,
             t_end: z,
             h: z,
             fac_old: z,
@@ -278,6 +367,7 @@ impl<L: Lane> Lanes<L> {
             y_new: [z; DIM],
             stage: [z; DIM],
             k: [[z; DIM]; 7],
+            cont: [[z; DIM]; 5],
             steps: z,
             rejected: z,
             rhs_evaluations: z,
@@ -336,6 +426,36 @@ impl<L: Lane> Lanes<L> {
                 rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
                 ..Stats::default()
             },
+        }
+    }
+
+    /// Lane `i`'s last accepted step (of an observed integration).
+    fn step_of(&self, i: usize) -> LaneStep {
+        LaneStep {
+            t_prev: self.t_prev.lane(i),
+            t: self.t.lane(i),
+            y: std::array::from_fn(|j| self.y[j].lane(i)),
+            cont: std::array::from_fn(|c| std::array::from_fn(|j| self.cont[c][j].lane(i))),
+            stats: Stats {
+                steps: self.steps.lane(i) as u64,
+                rejected_steps: self.rejected.lane(i) as u64,
+                rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
+                ..Stats::default()
+            },
+        }
+    }
+
+    /// Ends lane `i`'s run as [`LaneStatus::Ended`], whether it was still running or had just
+    /// ended (reaching its end time) in the last attempt.
+    #[cold]
+    #[inline(never)]
+    fn end_observed(&mut self, i: usize) {
+        if self.running.test(i) {
+            self.end(L::Mask::splat(false).with_lane(i, true), |_, _| {
+                LaneStatus::Ended
+            });
+        } else if let Some(e) = self.ended.iter_mut().find(|e| e.0 == i) {
+            e.1 = LaneStatus::Ended;
         }
     }
 
@@ -404,9 +524,10 @@ impl<L: Lane> Lanes<L> {
     }
 
     /// One attempted step in every running lane, accepted or rejected lane by lane, as the
-    /// scalar `Dopri5::step` takes it.
+    /// scalar `Dopri5::step` takes it; returns the lanes that accepted. With `observed`, the
+    /// accepted steps' dense output is kept.
     #[inline(always)]
-    fn attempt(&mut self) {
+    fn attempt(&mut self, observed: bool) -> L::Mask {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let end = adaptive_step_end(self.t, self.h.min(self.h_max), self.t_end);
         let underflow = end.underflow & self.running;
@@ -463,6 +584,11 @@ impl<L: Lane> Lanes<L> {
             L::select(reject, h_rejected, self.h),
         );
         self.fac_old = L::select(accept, fac_old, self.fac_old);
+        if observed {
+            // For every lane (the others' are not read): the scalar `Dopri5`'s coefficients.
+            dense_coefficients(h, &self.k, &self.y, &self.y_new, &mut self.cont);
+            self.t_prev = L::select(accept, self.t, self.t_prev);
+        }
         for j in 0..DIM {
             self.y[j] = L::select(accept, self.y_new[j], self.y[j]);
             // First same as last: the last stage is f at the new point.
@@ -495,12 +621,17 @@ impl<L: Lane> Lanes<L> {
         if done.any() {
             self.end(done, |_, _| LaneStatus::Complete);
         }
+        accept
     }
 }
 
 /// The lockstep integration of `runs` at lane type `L`; see the module documentation.
 #[inline(always)]
-fn lockstep<L: Lane>(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOutcome> {
+fn lockstep<L: Lane>(
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    mut observe: Option<Observer<'_>>,
+) -> Vec<LaneOutcome> {
     let mut outcomes: Vec<Option<LaneOutcome>> = vec![None; runs.len()];
     let Some(first) = runs.first() else {
         return Vec::new();
@@ -540,7 +671,17 @@ fn lockstep<L: Lane>(runs: &[DamperRun], settings: &LaneSettings) -> Vec<LaneOut
             lanes.start(starting);
         }
         if lanes.running.any() {
-            lanes.attempt();
+            let accepted = lanes.attempt(observe.is_some());
+            if let Some(observe) = observe.as_mut() {
+                for (i, slot) in held.iter().enumerate() {
+                    if let Some(index) = *slot
+                        && accepted.test(i)
+                        && !observe(index, &lanes.step_of(i))
+                    {
+                        lanes.end_observed(i);
+                    }
+                }
+            }
         }
         for (i, status) in std::mem::take(&mut lanes.ended) {
             if let Some(index) = held[i].take() {

@@ -768,6 +768,13 @@ impl Spacecraft {
         self.motion = Some(motion);
     }
 
+    /// Whether the right-hand side is the one effector's closed form for the whole system
+    /// ([`Effector::rhs_alone`]): a single effector moving mass, ungrouped, with no gravity
+    /// gradient and no prescribed motion.
+    pub fn takes_lone_closed_form(&self) -> bool {
+        self.motion.is_none() && self.lone_only
+    }
+
     /// The prescribed hub motion, if any.
     pub fn motion(&self) -> Option<&dyn HubMotion> {
         self.motion.as_deref()

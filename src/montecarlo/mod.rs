@@ -23,6 +23,7 @@ pub use spec::{Campaign, InvalidDraws, MAX_DRAWS_PER_RUN, MAX_RUNS};
 pub use summary::{percentile, wilson95};
 pub use table::{Row, RunStatus};
 
+use crate::lanes::damper::Engine;
 use crate::log::telemetry;
 use crate::model::Observation;
 use crate::scenario::{self, Overrides, Quantity, Scenario, ScenarioError};
@@ -120,6 +121,48 @@ pub struct Prepared {
     run_redraw_column: Option<usize>,
     /// Columns counting a dispersion's own redraws (`inertia_redraws`).
     redraw_columns: Vec<usize>,
+    /// How the runs are integrated: in lanes where the scene has a lane form.
+    pub integration: Integration,
+    /// Whether lanes are wanted where the scene has a lane form (`--no-lanes` clears it).
+    lanes_wanted: bool,
+}
+
+/// How a campaign's runs are integrated on each thread.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Integration {
+    /// Several runs at once in lockstep lanes with this engine (`crate::lanes`); a run the
+    /// lanes cannot take (its perturbed scene has no lane form, or the lanes decline it
+    /// part-way) takes the scalar path. Every run's row is the scalar path's.
+    Lanes(Engine),
+    /// One run after another, and why not in lanes.
+    Scalar(String),
+}
+
+impl Integration {
+    /// How the runs of `scenario` are integrated on this processor.
+    pub fn of(scenario: &Scenario) -> Self {
+        match sim::lane_form(scenario) {
+            Ok(_) => Integration::Lanes(crate::lanes::damper::resolved(Engine::Auto)),
+            Err(why) => Integration::Scalar(format!("the scene has no lane form: {why}")),
+        }
+    }
+
+    /// A line for the campaign's header: where the runs go and why.
+    pub fn describe(&self) -> String {
+        match self {
+            Integration::Lanes(Engine::Avx2) => {
+                "in lockstep lanes, four runs at once per thread (AVX2)".into()
+            }
+            Integration::Lanes(Engine::Portable4) => {
+                "in lockstep lanes, four runs at once per thread (SSE2)".into()
+            }
+            Integration::Lanes(_) => {
+                "in a lockstep lane, one run at a time per thread (this processor has no AVX2)"
+                    .into()
+            }
+            Integration::Scalar(why) => format!("one run at a time per thread ({why})"),
+        }
+    }
 }
 
 /// Hex SHA-256 of `bytes`.
@@ -400,7 +443,22 @@ impl Prepared {
             method: None,
             run_redraw_column,
             redraw_columns,
-        })
+            integration: Integration::Scalar(String::new()),
+            lanes_wanted: true,
+        }
+        .with_integration(true))
+    }
+
+    /// Runs in lanes where the nominal scene has a lane form (`lanes`), or every run on the
+    /// scalar path (`!lanes`, `--no-lanes`).
+    pub fn with_integration(mut self, lanes: bool) -> Self {
+        self.lanes_wanted = lanes;
+        self.integration = if lanes {
+            Integration::of(&self.scenario)
+        } else {
+            Integration::Scalar("--no-lanes".into())
+        };
+        self
     }
 
     /// The random stream of run `i`: ChaCha8 seeded with the campaign seed, stream `i`.
@@ -423,7 +481,8 @@ impl Prepared {
             self.scenario.simulation.method = nominal.simulation.method;
         }
         self.method = method;
-        Ok(self)
+        let lanes = self.lanes_wanted;
+        Ok(self.with_integration(lanes))
     }
 
     /// The perturbed scenario of run `i` and the recorded inputs (the dispersions' columns,
@@ -502,6 +561,68 @@ impl Prepared {
 
     /// [`Prepared::run_one`] with run `i` already built (by [`Prepared::build_run`]).
     fn run_built(&self, i: u64, built: Built, interrupt: &AtomicBool) -> Option<Row> {
+        let (sc, values) = match self.ready(i, built) {
+            Ok(x) => x,
+            Err(row) => return Some(*row),
+        };
+        self.run_scalar(i, &sc, values, interrupt)
+    }
+
+    /// Run `i` integrated on the scalar path.
+    fn run_scalar(
+        &self,
+        i: u64,
+        sc: &Scenario,
+        values: Vec<Option<f64>>,
+        interrupt: &AtomicBool,
+    ) -> Option<Row> {
+        let mut sink = Extremes::default();
+        let ctl = Control {
+            interrupt,
+            progress: None,
+        };
+        let outcome = sim::run(sc, &mut sink, ctl);
+        self.row(i, values, outcome, &sink)
+    }
+
+    /// The runs `chunk` (each index with its build) integrated together in lanes with
+    /// `engine`; a run the lanes do not take is integrated on the scalar path. The rows are
+    /// in the order of `chunk` (`None`: interrupted).
+    fn run_in_lanes(
+        &self,
+        engine: Engine,
+        chunk: Vec<(u64, Built)>,
+        interrupt: &AtomicBool,
+    ) -> Vec<Option<Row>> {
+        let mut rows: Vec<Option<Row>> = Vec::with_capacity(chunk.len());
+        let mut ready = Vec::new();
+        for (k, (i, built)) in chunk.into_iter().enumerate() {
+            match self.ready(i, built) {
+                Ok((sc, values)) => {
+                    rows.push(None);
+                    ready.push((k, i, sc, values));
+                }
+                Err(row) => rows.push(Some(*row)),
+            }
+        }
+        let sims: Vec<&sim::Simulation> = ready.iter().map(|r| &*r.2).collect();
+        // A sink error cannot happen (the extremes sink writes nothing); if one did, the
+        // scalar path would report it run by run.
+        let results = sim::run_in_lanes::<Extremes>(engine, &sims, interrupt)
+            .unwrap_or_else(|_| (0..sims.len()).map(|_| None).collect());
+        for ((k, i, sc, values), result) in ready.into_iter().zip(results) {
+            rows[k] = match result {
+                Some((outcome, sink)) => self.row(i, values, Ok(outcome), &sink),
+                None => self.run_scalar(i, &sc, values, interrupt),
+            };
+        }
+        rows
+    }
+
+    /// Run `i`'s scenario, ready to integrate, and its row's values so far (the inputs and
+    /// the initial transverse rate); `Err`: the row of an invalid draw.
+    #[allow(clippy::result_large_err)]
+    fn ready(&self, i: u64, built: Built) -> Result<(Scenario, Vec<Option<f64>>), Box<Row>> {
         let mut values = vec![None; self.columns.len()];
         let (sc, inputs) = match built {
             Ok(x) => x,
@@ -517,12 +638,12 @@ impl Prepared {
                 if let (Some(j), Some(n)) = (self.run_redraw_column, redraws) {
                     values[j] = Some(f64::from(n));
                 }
-                return Some(Row {
+                return Err(Box::new(Row {
                     run: i,
                     status: RunStatus::Invalid,
                     message,
                     values,
-                });
+                }));
             }
         };
         for (k, v) in inputs.iter().enumerate() {
@@ -538,12 +659,19 @@ impl Prepared {
             // the end and the events (docs/montecarlo.md).
             sc.simulation.output_rate = 1.0 / sc.duration;
         }
-        let mut sink = Extremes::default();
-        let ctl = Control {
-            interrupt,
-            progress: None,
-        };
-        let outcome = match sim::run(&sc, &mut sink, ctl) {
+        Ok((sc, values))
+    }
+
+    /// Run `i`'s row from its `values` so far, the outcome of its integration and what its
+    /// sink saw.
+    fn row(
+        &self,
+        i: u64,
+        mut values: Vec<Option<f64>>,
+        outcome: std::io::Result<sim::Outcome>,
+        sink: &Extremes,
+    ) -> Option<Row> {
+        let outcome = match outcome {
             Ok(o) => o,
             Err(e) => {
                 return Some(Row {
@@ -651,7 +779,33 @@ impl Prepared {
             // run's row does not depend on when or where it runs).
             let next = AtomicUsize::new(0);
             let slots: Vec<Mutex<Option<Row>>> = (0..n).map(|_| Mutex::new(None)).collect();
+            // Lanes take a chunk of runs at a time: enough to keep the lanes full (a lane that
+            // finishes takes the chunk's next run), few enough to share the block out.
+            let chunk = (n / (4 * threads.max(1))).clamp(8, 128);
             pool.broadcast(|_| {
+                while let Integration::Lanes(engine) = self.integration {
+                    let k = next.fetch_add(chunk, Ordering::Relaxed);
+                    if k >= n || interrupt.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let js = &order[k..(k + chunk).min(n)];
+                    let runs = js
+                        .iter()
+                        .map(|&j| {
+                            let i = block.start + j as u64;
+                            let prebuilt = built
+                                .get(j)
+                                .and_then(|b| b.lock().unwrap_or_else(|e| e.into_inner()).take());
+                            (i, prebuilt.unwrap_or_else(|| self.build_run(i)))
+                        })
+                        .collect();
+                    for (&j, row) in js.iter().zip(self.run_in_lanes(engine, runs, interrupt)) {
+                        if let Some(row) = row {
+                            on_row(&row);
+                            *slots[j].lock().unwrap_or_else(|e| e.into_inner()) = Some(row);
+                        }
+                    }
+                }
                 loop {
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     if k >= n || interrupt.load(Ordering::Relaxed) {
@@ -835,6 +989,9 @@ impl Sink for Extremes {
     fn event(&mut self, _: &EventRecord, o: &Observation) -> std::io::Result<()> {
         self.max_nutation = self.max_nutation.max(o.nutation_angle);
         Ok(())
+    }
+    fn reads_principal_angles(&self) -> bool {
+        false
     }
 }
 

@@ -8,8 +8,10 @@
 mod checks;
 mod condition;
 mod events;
+mod lanes;
 mod memory;
 mod method;
+mod monitor;
 mod relay;
 mod simulation;
 mod steppers;
@@ -17,6 +19,7 @@ mod support;
 
 pub use checks::{DriftLimits, OnBreach};
 pub use condition::{Condition, Quantity};
+pub use lanes::{lane_form, run_in_lanes};
 pub use memory::Memory;
 pub use method::{Adaptive, Method};
 pub use relay::{Record, Relay, Relayed, receive_run};
@@ -30,7 +33,7 @@ pub use support::{
 use crate::integrate::{OdeSystem, Stats, Stepper};
 use crate::model::{Invariants, Observation, Spacecraft};
 use crate::timefmt::seconds;
-use events::{Watch, far_from_crossing};
+use monitor::Monitor;
 use nalgebra::Vector3;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -186,6 +189,12 @@ pub trait Sink {
     fn warning(&mut self, _w: &Warning) -> std::io::Result<()> {
         Ok(())
     }
+    /// Whether this sink reads the samples' angles between ω and the principal axes
+    /// ([`Observation::angles_to_principal`], three arctangents a sample); a sink that says
+    /// false gets them as NaN, unless an event condition needs them anyway.
+    fn reads_principal_angles(&self) -> bool {
+        true
+    }
 }
 
 /// A sink that discards everything (runs without logging).
@@ -265,14 +274,7 @@ pub fn run(sim: &Simulation, sink: &mut dyn Sink, ctl: Control) -> std::io::Resu
     let sc = &sim.spacecraft;
     let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
     match AnyStepper::for_simulation(sim, &y0, true) {
-        Ok(stepper) => {
-            // Interior event checks where steps can be long (adaptive, implicit, splitting).
-            let interior_checks = match sim.method {
-                Method::Rk4 { .. } | Method::Lie { .. } => 0,
-                _ => 3,
-            };
-            drive(stepper, sim, sink, ctl, interior_checks)
-        }
+        Ok(stepper) => drive(stepper, sim, sink, ctl, interior_checks(&sim.method)),
         Err(diagnosis) => {
             let o = sc.observe(0.0, &y0);
             Ok(Outcome {
@@ -289,6 +291,15 @@ pub fn run(sim: &Simulation, sink: &mut dyn Sink, ctl: Control) -> std::io::Resu
                 wall_time: 0.0,
             })
         }
+    }
+}
+
+/// Interior event checks in a step of `method` (where steps can be long: adaptive, implicit,
+/// splitting).
+fn interior_checks(method: &Method) -> usize {
+    match method {
+        Method::Rk4 { .. } | Method::Lie { .. } => 0,
+        _ => 3,
     }
 }
 
@@ -409,103 +420,11 @@ fn drive<M: Stepper>(
     mut ctl: Control,
     interior_checks: usize,
 ) -> std::io::Result<Outcome> {
-    let started = Instant::now();
     let sc = &sim.spacecraft;
     let t_end = sim.duration;
-    let rate = sim.output_rate;
-    let n = sc.dim();
-    let mut buf = vec![0.0; n];
-
-    let o0 = sc.observe(0.0, stepper.y());
-    let inv = Reference::of(&o0);
-    let mut drift = Drift::default();
-    let mut events: Vec<EventRecord> = Vec::new();
-    let mut events_not_kept = 0u64;
-    let mut warnings: Vec<Warning> = Vec::new();
-    // Invariants already warned about (momentum, energy, quaternion norm).
-    let mut warned = [false; 3];
-    let limits = sim.drift_limits;
-    let mut window = (0u64, 0.0f64);
-    let mut collapsed_windows = 0u32;
-    let mut watches: Vec<Watch> = sim
-        .stop
-        .iter()
-        .map(|c| Watch::new(c, true))
-        .chain(sim.events.iter().map(|c| Watch::new(c, false)))
-        .collect();
-    // The event checks' observations compute the angles to the principal axes only when a
-    // condition watches one (three arctangents a check).
-    let watched_angles = watches
-        .iter()
-        .any(|w| matches!(w.condition.quantity, Quantity::AngleToPrincipalDeg(_)));
-    let observe_for_events = |t: f64, y: &[f64]| sc.observe_for_events(t, y, watched_angles);
-    // Effectors whose models have a validity range, and how far each has been reported
-    // (0: not yet, 1: warned, 2: warned past the limit).
-    let ranged: Vec<usize> = (0..sc.effectors().len())
-        .filter(|&k| {
-            sc.effectors()[k]
-                .validity_at(
-                    &sc.hub_state(0.0, stepper.y()),
-                    sc.effector_states(k, stepper.y()),
-                )
-                .is_some()
-        })
-        .collect();
-    let mut validity_reported = vec![0u8; sc.effectors().len()];
-
-    buf.copy_from_slice(stepper.y());
-    sink.sample(&o0, stepper.y(), &inv)?;
-    let mut samples = 1u64;
-    let mut next_k = 1u64;
-    let mut last_sample_t = 0.0;
-
-    // Conditions already true at t = 0 start holding there (and fire, without `for:`).
-    let mut status = None;
-    for w in watches.iter_mut() {
-        if w.start(w.condition.margin(&o0)).is_some() {
-            let e = EventRecord {
-                t: 0.0,
-                confirmed: 0.0,
-                condition: w.condition.describe(),
-                terminal: w.terminal,
-            };
-            sink.event(&e, &o0)?;
-            keep_event(&mut events, &mut events_not_kept, e);
-            if w.terminal && status.is_none() {
-                status = Some(Status::Stopped {
-                    condition: w.condition.describe(),
-                });
-            }
-        }
-    }
-    // A model already outside its range at t = 0.
-    if status.is_none()
-        && let Some(s) = check_validity(
-            sim,
-            &ranged,
-            &mut validity_reported,
-            0.0,
-            stepper.y(),
-            sink,
-            &mut warnings,
-        )?
-    {
-        status = Some(s);
-    }
-
-    let mut prev = o0.clone();
-    let mut last_obs = o0.clone();
-    // Event-check points of the current step: (time, observation).
-    let mut grid: Vec<(f64, Observation)> = Vec::with_capacity(interior_checks + 2);
-    // Each condition's margin at the start of the last step, and that step's size (s), for
-    // `far_from_crossing`; NaN: not known (the first step, or after a breakpoint).
-    let mut margins_before = vec![f64::NAN; watches.len()];
-    let mut h_before = 0.0;
-    // Set when the state went non-finite: the time of the last finite state (held in `buf`).
-    let mut last_good: Option<f64> = None;
+    let (mut monitor, mut status) = Monitor::start(sim, stepper.y(), sink, interior_checks)?;
+    let mut scratch = vec![0.0; sc.dim()];
     let mut last_poll = Instant::now();
-    // Scenes without a prescribed motion conserve the energy balance.
-    let passive = sc.conserves_energy();
     // Set when the last step ended on an effector's breakpoint.
     let mut at_breakpoint = false;
     while status.is_none() && stepper.t() < t_end {
@@ -524,10 +443,10 @@ fn drive<M: Stepper>(
         let t0 = stepper.t();
         if at_breakpoint {
             // Held states take their new values; the next step starts afresh on the far side.
-            buf.copy_from_slice(stepper.y());
-            sc.at_breakpoint(t0, &mut buf);
-            stepper.restart(sc, &buf);
-            margins_before.fill(f64::NAN);
+            scratch.copy_from_slice(stepper.y());
+            sc.at_breakpoint(t0, &mut scratch);
+            stepper.restart(sc, &scratch);
+            monitor.restarted();
         }
         let stop = next_stop(sc, t0, t_end);
         if let Err(e) = stepper.step(sc, stop) {
@@ -536,289 +455,16 @@ fn drive<M: Stepper>(
             });
             break;
         }
-        let t1 = stepper.t();
         // A breakpoint reached: restart before the next step (this step's samples and events
         // are read from its dense output first, on the breakpoint's near side).
-        at_breakpoint = t1 == stop && stop < t_end;
-        if !stepper.y().iter().all(|v| v.is_finite()) {
-            // Report the last finite state: the start of the failed step.
-            let t_good = stepper.t_prev();
-            stepper.interpolate(t_good, &mut buf);
-            let what = format!(
-                "the state became non-finite in the step from t = {} to t = {}",
-                seconds(t_good),
-                seconds(t1)
-            );
-            status = Some(Status::Failed {
-                diagnosis: diagnose(&what, t_good, &buf, sim),
-            });
-            last_good = Some(t_good);
-            break;
-        }
-        // The full observation (angles) only when events need it; the drift check reads
-        // its invariants then, and computes them alone otherwise.
-        let o1 = if watches.is_empty() {
-            None
-        } else {
-            Some(observe_for_events(t1, stepper.y()))
-        };
-        let step_invariants = match &o1 {
-            Some(o) => o.invariants(),
-            None => sc.invariants(t1, stepper.y()),
-        };
-        inv.update(&mut drift, &step_invariants);
-        if passive && drift.energy_rel > DIVERGENCE_ENERGY_REL {
-            let what = format!(
-                "the energy balance (kinetic + elastic + dissipated) changed by {:.0}% by \
-                 t = {}, which no passive scene can do: the integration is diverging",
-                100.0 * drift.energy_rel,
-                seconds(t1)
-            );
-            status = Some(Status::Failed {
-                diagnosis: diagnose(&what, t1, stepper.y(), sim),
-            });
-            break;
-        }
-        if let Some((which, what)) = drift_excess(&limits, &drift, &warned, t1) {
-            let message = drift_message(&what, t1, stepper.y(), sim);
-            match limits.on_drift {
-                OnBreach::Stop => {
-                    status = Some(Status::Failed { diagnosis: message });
-                    break;
-                }
-                OnBreach::Warn => {
-                    warned[which] = true;
-                    let w = Warning { t: t1, message };
-                    sink.warning(&w)?;
-                    warnings.push(w);
-                }
-            }
-        }
-        let steps = stepper.stats().steps;
-        if steps >= window.0 + COLLAPSE_WINDOW {
-            let h_avg = (t1 - window.1) / (steps - window.0) as f64;
-            let whole = t_end / h_avg;
-            collapsed_windows = if whole > MAX_STEPS_TO_GO {
-                collapsed_windows + 1
-            } else {
-                0
-            };
-            if collapsed_windows >= 2 {
-                let what = format!(
-                    "the step size collapsed: the last {} steps averaged h = {h_avg:.3e} s, a \
-                     step at which the {t_end} s run would take {whole:.1e} steps (limit \
-                     {MAX_STEPS_TO_GO:e})",
-                    COLLAPSE_WINDOW
-                );
-                status = Some(Status::Failed {
-                    diagnosis: diagnose(&what, t1, stepper.y(), sim),
-                });
-                break;
-            }
-            window = (steps, t1);
-        }
-        if !ranged.is_empty()
-            && let Some(s) = check_validity(
-                sim,
-                &ranged,
-                &mut validity_reported,
-                t1,
-                stepper.y(),
-                sink,
-                &mut warnings,
-            )?
-        {
-            status = Some(s);
-            break;
-        }
-        // Events inside (t0, t1]: check interior points too, so that a quantity that crosses
-        // and re-crosses within one long step is not missed.
-        // (event time, time known, condition, terminal)
-        let mut found: Vec<(f64, f64, &Condition, bool)> = Vec::new();
-        if let Some(o1) = &o1 {
-            // Interior points only where a margin could cross and re-cross inside the step
-            // (`far_from_crossing`): elsewhere the step's ends decide, and the dense output
-            // is not needed.
-            let h = t1 - t0;
-            let mut near = false;
-            for (watch, g_before) in watches.iter().zip(margins_before.iter_mut()) {
-                let (ga, gb) = (watch.condition.margin(&prev), watch.condition.margin(o1));
-                near |= watch.active() && !far_from_crossing(*g_before, ga, gb, h_before, h);
-                *g_before = ga;
-            }
-            h_before = h;
-            let checks = if near { interior_checks } else { 0 };
-            if checks > 0 && !stepper.prepare_interpolation(sc) {
-                status = Some(dense_failure(t0, t1, stepper.y(), sim));
-                break;
-            }
-            // Reused across steps: no allocation per step once it has grown.
-            grid.clear();
-            grid.push((t0, prev.clone()));
-            for j in 1..=checks {
-                let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
-                stepper.interpolate(t, &mut buf);
-                grid.push((t, observe_for_events(t, &buf)));
-            }
-            grid.push((t1, o1.clone()));
-            // A sign change is located on the dense output.
-            let bracketed = watches.iter().filter(|w| w.active()).any(|w| {
-                grid.windows(2).any(|p| {
-                    (w.condition.margin(&p[0].1) > 0.0) != (w.condition.margin(&p[1].1) > 0.0)
-                })
-            });
-            if bracketed && !stepper.prepare_interpolation(sc) {
-                status = Some(dense_failure(t0, t1, stepper.y(), sim));
-                break;
-            }
-            for watch in watches.iter_mut().filter(|w| w.active()) {
-                let c = watch.condition;
-                for w in grid.windows(2) {
-                    let (a, b) = (w[0].0, w[1].0);
-                    let (ga, gb) = (c.margin(&w[0].1), c.margin(&w[1].1));
-                    let crossing = |up: bool| {
-                        let mut scratch = vec![0.0; n];
-                        let margin = |t: f64, y: &[f64]| c.margin(&observe_for_events(t, y));
-                        if up {
-                            locate(&stepper, &margin, a, b, ga, gb, &mut scratch)
-                        } else {
-                            locate(
-                                &stepper,
-                                &|t, y| -margin(t, y),
-                                a,
-                                b,
-                                -ga,
-                                -gb,
-                                &mut scratch,
-                            )
-                        }
-                    };
-                    if let Some(f) = watch.advance(a, b, ga, gb, crossing) {
-                        found.push((f.t, f.confirmed, c, watch.terminal));
-                        if watch.terminal || !watch.active() {
-                            break;
-                        }
-                    }
-                }
-            }
-            found.sort_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some(i) = found.iter().position(|f| f.3) {
-                found.truncate(i + 1);
-            }
-        }
-        let stop_at = found.last().filter(|f| f.3).map(|f| f.1);
-        let horizon = stop_at.unwrap_or(t1);
-        // Samples and events inside the step are read from the dense output.
-        let inside = (next_k as f64 / rate) < horizon.min(t1) || !found.is_empty();
-        if inside && !stepper.prepare_interpolation(sc) {
-            status = Some(dense_failure(t0, t1, stepper.y(), sim));
-            break;
-        }
-
-        // Samples on the grid up to the horizon, interleaved with events in time order.
-        let mut pending = found.iter().peekable();
-        loop {
-            let tk = next_k as f64 / rate;
-            let next_event_t = pending.peek().map(|f| f.1);
-            let sample_due = tk <= horizon && tk <= t_end;
-            match (sample_due, next_event_t) {
-                (true, Some(te)) if te < tk => {}
-                (true, _) => {
-                    let o = if tk == t1 {
-                        buf.copy_from_slice(stepper.y());
-                        match &o1 {
-                            Some(o) if watched_angles => o.clone(),
-                            Some(o) => Observation {
-                                angles_to_principal: sc.angles_to_principal(&o.omega),
-                                ..o.clone()
-                            },
-                            None => sc.observe(t1, &buf),
-                        }
-                    } else {
-                        stepper.interpolate(tk, &mut buf);
-                        sc.observe(tk, &buf)
-                    };
-                    sink.sample(&o, &buf, &inv)?;
-                    samples += 1;
-                    next_k += 1;
-                    last_sample_t = tk;
-                    continue;
-                }
-                (false, None) => break,
-                (false, Some(_)) => {}
-            }
-            // An event comes first.
-            let Some(&(t_event, te, c, terminal)) = pending.next() else {
-                break;
-            };
-            stepper.interpolate(te, &mut buf);
-            let o = sc.observe(te, &buf);
-            let e = EventRecord {
-                t: t_event,
-                confirmed: te,
-                condition: c.describe(),
-                terminal,
-            };
-            sink.event(&e, &o)?;
-            keep_event(&mut events, &mut events_not_kept, e);
-            if terminal {
-                if te > last_sample_t {
-                    sink.sample(&o, &buf, &inv)?;
-                    samples += 1;
-                    last_sample_t = te;
-                }
-                last_obs = o;
-                status = Some(Status::Stopped {
-                    condition: c.describe(),
-                });
-                break;
-            }
-        }
-        if status.is_none()
-            && let Some(o1) = o1
-        {
-            prev = o1;
-        }
+        at_breakpoint = stepper.t() == stop && stop < t_end;
+        status = monitor.after_step(&mut stepper, sink)?;
     }
-    let status = status.unwrap_or(Status::Complete);
-    // With `for:`, events are known out of time order; list them in time order.
-    events.sort_by(|a, b| a.t.total_cmp(&b.t));
-    // The last instant reached is always logged, on the grid or not.
-    let final_state = if matches!(status, Status::Stopped { .. }) || last_good.is_some() {
-        buf.clone()
-    } else {
-        stepper.y().to_vec()
-    };
-    if let Some(t_good) = last_good {
-        last_obs = sc.observe(t_good, &buf);
-        if t_good > last_sample_t {
-            sink.sample(&last_obs, &buf, &inv)?;
-            samples += 1;
-        }
-    } else if !matches!(status, Status::Stopped { .. }) {
-        let o = sc.observe(stepper.t(), stepper.y());
-        if stepper.t() > last_sample_t && stepper.y().iter().all(|v| v.is_finite()) {
-            sink.sample(&o, stepper.y(), &inv)?;
-            samples += 1;
-        }
-        last_obs = o;
-    }
+    let outcome = monitor.finish(&stepper, status, sink)?;
     if let Some(p) = ctl.progress.as_mut() {
-        p(last_obs.t);
+        p(outcome.final_observation.t);
     }
-    Ok(Outcome {
-        status,
-        final_observation: last_obs,
-        initial_observation: o0,
-        final_state,
-        stats: stepper.stats(),
-        drift,
-        events,
-        events_not_kept,
-        warnings,
-        samples,
-        wall_time: started.elapsed().as_secs_f64(),
-    })
+    Ok(outcome)
 }
 
 /// The diagnosis when a step's deferred dense output comes out non-finite.
@@ -831,49 +477,6 @@ fn dense_failure(t0: f64, t1: f64, y: &[f64], sim: &Simulation) -> Status {
     Status::Failed {
         diagnosis: diagnose(&what, t1, y, sim),
     }
-}
-
-/// Locates the root of `margin` (of the time and the state there) in `[a, b]` on the dense
-/// output (Illinois regula falsi), given `margin(a) = ga ≤ 0 < gb = margin(b)`.
-fn locate<M: Stepper>(
-    stepper: &M,
-    margin: &dyn Fn(f64, &[f64]) -> f64,
-    mut a: f64,
-    mut b: f64,
-    mut ga: f64,
-    mut gb: f64,
-    buf: &mut [f64],
-) -> f64 {
-    // Relative to the time itself (documented as ~1e-13 relative), never below a few ulps.
-    let tol = (1e-13 * a.abs().max(b.abs())).max(4.0 * f64::EPSILON * b.abs());
-    let mut side = 0i8;
-    for _ in 0..200 {
-        if (b - a).abs() <= tol {
-            break;
-        }
-        let t = ((a * gb - b * ga) / (gb - ga)).clamp(a.min(b), a.max(b));
-        stepper.interpolate(t, buf);
-        let g = margin(t, buf);
-        if g > 0.0 {
-            b = t;
-            gb = g;
-            if side == 1 {
-                ga *= 0.5;
-            }
-            side = 1;
-        } else {
-            a = t;
-            ga = g;
-            if side == -1 {
-                gb *= 0.5;
-            }
-            side = -1;
-        }
-        if g == 0.0 {
-            return t;
-        }
-    }
-    b
 }
 
 /// Where an explicit method's stability region meets the negative real axis, in units of

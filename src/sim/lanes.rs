@@ -1,0 +1,215 @@
+//! Runs integrated in lockstep lanes ([`crate::lanes`]), each watched by the run monitor the
+//! scalar loop uses: the same samples, events, invariants and checks, from the same steps and
+//! the same dense output, so a run's outcome is the scalar path's (docs/montecarlo.md, "Lanes
+//! in a campaign").
+//!
+//! Today's lane form is the nutation-damper class ([`crate::lanes::damper`]): a rigid hub
+//! with one spring–mass damper, integrated by dopri5. [`lane_form`] says why another scene
+//! has none; such a run, or one the lanes decline part-way, takes the scalar path.
+
+use super::monitor::{Monitor, StepView};
+use super::{Method, Outcome, Simulation, Sink, Status, diagnose, interior_checks};
+use crate::effectors::particles::ParticleEffector;
+use crate::effectors::spring_mass::SpringMass;
+use crate::integrate::{Stats, Tolerances};
+use crate::lanes::damper::{
+    DIM, DamperRun, Engine, LaneSettings, LaneStatus, LaneStep, integrate_runs_observed_with,
+};
+use crate::model::Spacecraft;
+use std::any::Any;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A lane's step as the monitor reads it: the dense output is always there.
+struct LaneView<'s>(&'s LaneStep);
+
+impl StepView for LaneView<'_> {
+    fn t(&self) -> f64 {
+        self.0.t
+    }
+    fn t_prev(&self) -> f64 {
+        self.0.t_prev
+    }
+    fn y(&self) -> &[f64] {
+        &self.0.y
+    }
+    fn interpolate(&self, t: f64, out: &mut [f64]) {
+        self.0.interpolate(t, out);
+    }
+    fn prepare_interpolation(&mut self, _: &Spacecraft) -> bool {
+        true
+    }
+    fn stats(&self) -> Stats {
+        self.0.stats
+    }
+}
+
+/// `sim` as a run of the lanes' nutation-damper class and the integration settings it needs,
+/// or why it is not one (a sentence fragment: "its method is radau5, …").
+pub fn lane_form(sim: &Simulation) -> Result<(DamperRun, LaneSettings), String> {
+    let sc = &sim.spacecraft;
+    let Method::Dopri5(a) = sim.method else {
+        return Err(format!(
+            "its method is {}, and the lanes integrate with dopri5 only",
+            sim.method.name()
+        ));
+    };
+    if let Some(refusal) = sim.method.refusal(sc, sim.duration) {
+        return Err(format!("dopri5 refuses it ({refusal})"));
+    }
+    let damper = match sc.effectors() {
+        [one] => {
+            let any: &dyn Any = one.as_ref();
+            any.downcast_ref::<ParticleEffector<SpringMass>>()
+                .map(ParticleEffector::model)
+                .ok_or_else(|| {
+                    format!(
+                        "its effector `{}` ({}) has no lane form (the lanes have the \
+                         spring_mass_damper alone)",
+                        one.name(),
+                        one.kind()
+                    )
+                })?
+        }
+        list => {
+            return Err(format!(
+                "it has {} effectors, and the lanes have a hub with one spring_mass_damper only",
+                list.len()
+            ));
+        }
+    };
+    if !sc.takes_lone_closed_form() || sc.next_breakpoint(0.0).is_some() {
+        return Err("its right-hand side is not the damper's closed form alone".into());
+    }
+    let hub_mass = sc
+        .hub_mass
+        .ok_or_else(|| "its hub has no mass".to_string())?;
+    let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
+    let run = DamperRun {
+        hub_inertia: sc.hub.inertia,
+        hub_mass,
+        damper: damper.clone(),
+        omega0: sim.omega0,
+        attitude0: sim.attitude0,
+        offset0: y0.get(7).copied().unwrap_or(f64::NAN),
+        rate0: y0.get(8).copied().unwrap_or(f64::NAN),
+        t_end: sim.duration,
+    };
+    let same_start = y0.len() == DIM
+        && run
+            .initial_state()
+            .iter()
+            .zip(&y0)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+    if !same_start {
+        return Err("its state is not laid out as the lanes' (ω, q, ρ, ρ̇, E)".into());
+    }
+    let settings = LaneSettings {
+        tolerances: Tolerances {
+            rtol: a.rtol,
+            atol: a.atol,
+        },
+        h_max: a.max_step,
+    };
+    Ok((run, settings))
+}
+
+/// One run in the lanes: its monitor, its sink, and the status its monitor ended it with.
+struct Watched<'a, S> {
+    index: usize,
+    monitor: Monitor<'a>,
+    sink: S,
+    status: Option<Status>,
+}
+
+/// Runs `sims` (the runs of one campaign) in lockstep lanes with `engine`, each feeding a sink
+/// of its own. Returns, in the order of `sims`, each run's outcome and sink, or `None` for a
+/// run that must take the scalar path: it has no lane form ([`lane_form`]), its settings
+/// differ from the first lane run's, or the lanes declined it part-way (its sink is then
+/// dropped, so a scalar run starts afresh). `interrupt` ends the runs after their current step
+/// with [`Status::Interrupted`].
+pub fn run_in_lanes<S: Sink + Default>(
+    engine: Engine,
+    sims: &[&Simulation],
+    interrupt: &AtomicBool,
+) -> std::io::Result<Vec<Option<(Outcome, S)>>> {
+    let mut results: Vec<Option<(Outcome, S)>> = (0..sims.len()).map(|_| None).collect();
+    let mut shared: Option<LaneSettings> = None;
+    let mut runs = Vec::new();
+    let mut watched: Vec<Watched<S>> = Vec::new();
+    for (index, sim) in sims.iter().enumerate() {
+        let Ok((run, settings)) = lane_form(sim) else {
+            continue;
+        };
+        let same = |s: &LaneSettings| {
+            s.tolerances == settings.tolerances && s.h_max.to_bits() == settings.h_max.to_bits()
+        };
+        if !same(shared.get_or_insert(settings)) {
+            continue;
+        }
+        let y0 = run.initial_state();
+        let mut sink = S::default();
+        let (monitor, status) = Monitor::start(sim, &y0, &mut sink, interior_checks(&sim.method))?;
+        let steps_ahead = sim.duration > 0.0;
+        if status.is_some() || !steps_ahead {
+            // Ended at t = 0, as the scalar loop does without a step.
+            let start = LaneStep {
+                t_prev: 0.0,
+                t: 0.0,
+                y: y0,
+                cont: [[0.0; DIM]; 5],
+                stats: Stats::default(),
+            };
+            let outcome = monitor.finish(&LaneView(&start), status, &mut sink)?;
+            results[index] = Some((outcome, sink));
+            continue;
+        }
+        runs.push(run);
+        watched.push(Watched {
+            index,
+            monitor,
+            sink,
+            status: None,
+        });
+    }
+    let Some(settings) = shared else {
+        return Ok(results);
+    };
+    let mut io_error = None;
+    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step| {
+        let w = &mut watched[k];
+        if interrupt.load(Ordering::Relaxed) {
+            w.status = Some(Status::Interrupted);
+            return false;
+        }
+        match w.monitor.after_step(&mut LaneView(step), &mut w.sink) {
+            Ok(None) => true,
+            Ok(Some(status)) => {
+                w.status = Some(status);
+                false
+            }
+            Err(e) => {
+                w.status = Some(Status::Interrupted);
+                io_error.get_or_insert(e);
+                false
+            }
+        }
+    });
+    if let Some(e) = io_error {
+        return Err(e);
+    }
+    for (w, outcome) in watched.into_iter().zip(outcomes) {
+        let sim = sims[w.index];
+        let status = match &outcome.status {
+            LaneStatus::Declined { .. } => continue,
+            LaneStatus::Complete | LaneStatus::Ended => w.status,
+            LaneStatus::Failed(e) => Some(Status::Failed {
+                diagnosis: diagnose(&e.to_string(), outcome.t, &outcome.y, sim),
+            }),
+        };
+        let mut sink = w.sink;
+        let end = LaneStep::at_end(&outcome);
+        let result = w.monitor.finish(&LaneView(&end), status, &mut sink)?;
+        results[w.index] = Some((result, sink));
+    }
+    Ok(results)
+}

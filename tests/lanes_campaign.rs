@@ -1,0 +1,163 @@
+//! A campaign's runs in lockstep lanes against the same campaign on the scalar path, row by row
+//! and bit for bit: statuses, messages, events, largest nutation, final state metrics, steps and
+//! right-hand-side counts. The cases cover what the run monitor does around the lanes' steps:
+//! output samples and events on the dense output, a terminal event, a drift bound that stops
+//! runs, a step-size bound, dispersions that make some draws invalid, and runs of different
+//! lengths (a lane that finishes takes the next run).
+//!
+//!   cargo test --release --test lanes_campaign
+
+use polhode::montecarlo::{Integration, Prepared, Row};
+use polhode::scenario::{self, Overrides};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// scenarios/nutation-damper.yaml's scene, with `integrator`, `extra` top-level keys and a
+/// campaign of `runs` runs over `dispersions`.
+fn campaign(integrator: &str, extra: &str, runs: u64, dispersions: &str) -> Prepared {
+    let yaml = format!(
+        "name: lanes\n\
+         body:\n  mass: 5274.4\n  principal: [1375.7, 1292.5, 1402.4]\n  spin_axis: [0, 0, 1]\n\
+         effectors:\n  - spring_mass_damper:\n      name: damper\n      mass: 52.744\n      \
+         position: [1.0, 0.0, 0.0]\n      direction: [0, 0, 1]\n      stiffness: 52.744\n      \
+         damping: 105.49\n\
+         initial:\n  omega: [0.1, 0.0, 1.0]\n\
+         integrator: {integrator}\n\
+         {extra}\
+         montecarlo:\n  runs: {runs}\n  seed: 7\n  invalid_draws: exclude\n  dispersions:\n{dispersions}"
+    );
+    let sc = scenario::parse(Path::new("lanes.yaml"), yaml, &Overrides::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    Prepared::new(sc, "lanes.yaml", None, None).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn rows(p: &Prepared, threads: usize) -> Vec<Row> {
+    let never = AtomicBool::new(false);
+    let (rows, partial) = p
+        .execute(0..p.campaign.runs, threads, &never, &|_| {})
+        .expect("the campaign runs");
+    assert!(!partial);
+    rows
+}
+
+/// Runs `p` in lanes and on the scalar path and compares every row bit for bit; returns the
+/// rows.
+fn assert_same_rows(p: Prepared) -> Vec<Row> {
+    assert!(
+        matches!(p.integration, Integration::Lanes(_)),
+        "expected lanes: {:?}",
+        p.integration
+    );
+    let lanes = rows(&p, 2);
+    let p = p.with_integration(false);
+    assert!(matches!(p.integration, Integration::Scalar(_)));
+    let scalar = rows(&p, 1);
+    assert_eq!(lanes.len(), scalar.len());
+    for (a, b) in lanes.iter().zip(&scalar) {
+        assert_eq!(a.run, b.run);
+        assert_eq!(
+            a.status, b.status,
+            "run {}: {} vs {}",
+            a.run, a.message, b.message
+        );
+        assert_eq!(a.message, b.message, "run {}", a.run);
+        for (k, (x, y)) in a.values.iter().zip(&b.values).enumerate() {
+            assert_eq!(
+                x.map(f64::to_bits),
+                y.map(f64::to_bits),
+                "run {}, column {} ({}): {x:?} vs {y:?}",
+                a.run,
+                k,
+                p.columns[k]
+            );
+        }
+    }
+    lanes
+}
+
+const DISPERSED: &str = "    - {path: \"initial.omega[0]\", normal: {sd: 0.02}}\n    \
+                         - {path: \"initial.omega[2]\", normal: {sd: 0.01, relative: true}}\n    \
+                         - {path: \"effectors[damper].damping\", log_normal: {sigma: 0.2}}\n";
+
+/// The nutation-damper campaign's events (a `once` crossing and a `for:` settling time) on
+/// 20 Hz output samples, runs of different lengths.
+#[test]
+fn a_damper_campaign_gives_the_scalar_rows_in_lanes() {
+    let p = campaign(
+        "{method: dopri5, rtol: 1.0e-10, atol: 1.0e-12}",
+        "duration: 200.0\noutput: {rate: 20}\nevents:\n  \
+         - nutation_angle_deg: {below: 1.0, once: true}\n  \
+         - nutation_angle_deg: {below: 1.0, for: 20.0}\n",
+        11,
+        &format!("{DISPERSED}    - {{path: duration, uniform: {{min: 50.0, max: 200.0}}}}\n"),
+    );
+    let rows = assert_same_rows(p);
+    // The events did fire, so their location on the lanes' dense output was compared.
+    assert!(
+        rows.iter()
+            .filter(|r| r.values.iter().flatten().count() > 0)
+            .count()
+            == 11
+    );
+}
+
+/// A terminal condition ends some runs part-way (the lane takes the next run), and loose
+/// tolerances bring rejected steps.
+#[test]
+fn a_terminal_event_and_rejections_give_the_scalar_rows_in_lanes() {
+    let p = campaign(
+        "{method: dopri5, rtol: 1.0e-5, atol: 1.0e-7}",
+        "duration: 120.0\noutput: {rate: 5}\nstop: [{nutation_angle_deg: {below: 3.0}}]\n",
+        10,
+        &format!("{DISPERSED}    - {{path: duration, uniform: {{min: 5.0, max: 120.0}}}}\n"),
+    );
+    let rows = assert_same_rows(p);
+    let stopped = rows.iter().filter(|r| r.message.contains("below")).count();
+    assert!(
+        stopped > 0 && stopped < 10,
+        "{stopped} of 10 runs stopped: the case should mix both"
+    );
+}
+
+/// A drift bound under `on_drift: stop` fails some runs at the step that breaches it, a
+/// largest step bounds the steps, and invalid draws (a negative damping) are rows too.
+#[test]
+fn checks_a_step_bound_and_invalid_draws_give_the_scalar_rows_in_lanes() {
+    let p = campaign(
+        "{method: dopri5, rtol: 1.0e-6, atol: 1.0e-8, max_step: 0.5}",
+        "duration: 60.0\noutput: {rate: 2}\n\
+         checks: {max_drift: {momentum: 3.0e-9}, on_drift: stop}\n",
+        12,
+        "    - {path: \"initial.omega[0]\", normal: {sd: 0.05}}\n    \
+         - {path: \"effectors[damper].damping\", normal: {sd: 200.0}}\n",
+    );
+    let rows = assert_same_rows(p);
+    let statuses: std::collections::BTreeSet<String> =
+        rows.iter().map(|r| format!("{:?}", r.status)).collect();
+    assert!(statuses.len() > 2, "too few statuses: {statuses:?}");
+}
+
+/// A scene without a lane form, or a method the lanes do not have, runs on the scalar path
+/// and says why.
+#[test]
+fn a_scene_without_a_lane_form_says_why() {
+    let p = campaign(
+        "{method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+        "duration: 10.0\n",
+        2,
+        DISPERSED,
+    );
+    match &p.integration {
+        Integration::Scalar(why) => assert!(why.contains("dop853"), "{why}"),
+        other => panic!("expected the scalar path, got {other:?}"),
+    }
+    let p = campaign(
+        "{method: dopri5, rtol: 1.0e-10, atol: 1.0e-12}",
+        "duration: 10.0\n",
+        2,
+        DISPERSED,
+    )
+    .with_method(Some("radau5".into()))
+    .unwrap();
+    assert!(matches!(&p.integration, Integration::Scalar(why) if why.contains("radau5")));
+}
