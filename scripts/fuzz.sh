@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds and runs the cargo-fuzz targets of fuzz/ (fuzz/README.md) for a while each, on the
-# stable toolchain.
+# stable toolchain that rust-toolchain.toml pins (1.97.1).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET]        (default 30)
 #
@@ -19,7 +19,7 @@
 #   FUZZ_KEEP_GOING=1             keep fuzzing past a finding (-fork=1 -ignore_crashes=1 ...),
 #                                 for long local runs; every finding is still saved and reported
 #   FUZZ_JOBS=N                   targets run at once (default: 2 if there are 2 cores or more)
-#   FUZZ_TOOLCHAIN=NAME           rustup toolchain (default: stable when rustup knows it)
+#   FUZZ_TOOLCHAIN=NAME           rustup toolchain (default: the one rust-toolchain.toml pins)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 root=$(pwd)
@@ -52,8 +52,6 @@ fi
 toolchain=()
 if [[ -n ${FUZZ_TOOLCHAIN:-} ]]; then
     toolchain=("+$FUZZ_TOOLCHAIN")
-elif command -v rustup >/dev/null && rustup toolchain list 2>/dev/null | grep -q '^stable'; then
-    toolchain=(+stable)
 fi
 cargo_() { cargo "${toolchain[@]}" "$@"; }
 
