@@ -12,7 +12,8 @@ scenarios/nutation-damper.yaml (its `montecarlo:` block: 200 runs of 600 s, dopr
            after another in this process, no events and no dense output
 
 Each is reported as runs per second of wall time and per second of CPU time (user + system),
-on one core. polhode's figures are whole campaigns (process start, parsing, drawing, the
+on one core; for polhode the best of REPEATS campaigns each way, lanes and scalar alternated
+(and the ratio of each adjacent pair, whose median is steadier on a loaded machine). polhode's figures are whole campaigns (process start, parsing, drawing, the
 20 Hz samples, the two events, the drift checks, writing runs.csv, runs.parquet and the
 summaries); SciPy's are the solve_ivp calls alone. SciPy at rtol 1e-11 takes seconds a run,
 so it integrates the first SCIPY_RUNS runs of the campaign.
@@ -131,8 +132,10 @@ def versions():
         except OSError:
             v[key] = "?"
     try:
-        v["polhode_commit"] = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
-                                             capture_output=True, text=True).stdout.strip()
+        # The last commit that changed polhode itself (not peers/ or docs/).
+        v["polhode_commit"] = subprocess.run(
+            ["git", "-C", ROOT, "log", "-1", "--format=%h", "--", "src", "Cargo.toml", "Cargo.lock"],
+            capture_output=True, text=True).stdout.strip()
     except OSError:
         pass
     try:
@@ -202,8 +205,12 @@ def main():
             f"{r['runs_per_cpu_s']:.3f} runs/CPU-s); energy dissipated within "
             f"{r['energy_dissipated_max_rel_diff_vs_polhode']:.1e} of polhode's rows")
     lanes, scalar = out["polhode"]["lanes"], out["polhode"]["scalar"]
+    paired = sorted(a["runs_per_cpu_s"] / b["runs_per_cpu_s"]
+                    for a, b in zip(trials["lanes"], trials["scalar"]))
     out["ratios"] = {
         "lanes_over_scalar": lanes["runs_per_cpu_s"] / scalar["runs_per_cpu_s"],
+        "lanes_over_scalar_paired": paired,
+        "lanes_over_scalar_paired_median": paired[len(paired) // 2],
         "lanes_over_scalar_wall": lanes["runs_per_s"] / scalar["runs_per_s"],
         **{f"lanes_over_scipy_{m}": lanes["runs_per_cpu_s"] / out["scipy"][m]["runs_per_cpu_s"]
            for m in SCIPY_METHODS},
