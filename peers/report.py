@@ -250,6 +250,55 @@ def block_environment(bsk_env, pol_env):
     return "\n".join(lines)
 
 
+def rate(x):
+    return f"{x:.3g}" if x < 10 else f"{x:.0f}" if x >= 100 else f"{x:.1f}"
+
+
+def block_campaign(camp):
+    if camp is None:
+        return "_Not run (peers/campaign.py writes peers/results/campaign.json)._"
+    c, v = camp["campaign"], camp["versions"]
+    lanes, scalar = camp["polhode"]["lanes"], camp["polhode"]["scalar"]
+    load = v.get("load_average_at_start")
+    lines = [
+        f"Generated {camp['generated']} by `peers/campaign.py` ({camp['wall_seconds']:.0f} s): "
+        f"`{camp['scenario']}`, {c['runs']} runs of {c['duration']:g} s (seed {c['seed']}), "
+        f"{c['method']} at rtol {c['rtol']:g}, atol {c['atol']:g}; {v.get('cpu', '?')}, "
+        f"{v.get('cores', '?')} cores, AVX2 {'yes' if v.get('avx2') else 'no'}"
+        + (f", load average {load[0]:.2f} at the start" if load else "")
+        + f"; `{v.get('polhode', '?')}` (source of commit {v.get('polhode_commit', '?')}), SciPy {v['scipy']}. "
+        f"polhode: best of {camp['repeats']} campaigns each way, alternated; SciPy: once.",
+        "",
+        "| one thread | runs | steps a run | seconds | runs/s (wall) | runs per CPU-second | "
+        "lanes ÷ it (CPU) |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    rows = [("polhode, lanes (`--threads 1 --shard 1/1`)", lanes),
+            ("polhode, `--no-lanes`", scalar)]
+    rows += [(f"SciPy `solve_ivp` {m} (first {r['runs']} runs)", r) for m, r in camp["scipy"].items()]
+    for label, r in rows:
+        lines.append(f"| {label} | {r['runs']} | {r['steps_per_run']:.0f} | {r['seconds']:.2f} | "
+                     f"{rate(r['runs_per_s'])} | {rate(r['runs_per_cpu_s'])} | "
+                     f"{rate(lanes['runs_per_cpu_s'] / r['runs_per_cpu_s'])} |")
+    lo_hi = {k: (min(t["all_runs_per_cpu_s"]), max(t["all_runs_per_cpu_s"]))
+             for k, t in camp["polhode"].items()}
+    lines += [
+        "",
+        f"Every repeat, runs per CPU-second: lanes {lo_hi['lanes'][0]:.0f}–{lo_hi['lanes'][1]:.0f}, "
+        f"`--no-lanes` {lo_hi['scalar'][0]:.0f}–{lo_hi['scalar'][1]:.0f}; lanes ÷ `--no-lanes` "
+        f"within each adjacent pair: "
+        + ", ".join(f"{x:.2f}" for x in camp["ratios"]["lanes_over_scalar_paired"])
+        + f" (median {camp['ratios']['lanes_over_scalar_paired_median']:.2f}). Header lines: "
+        f"`{lanes['path']}` and `{scalar['path']}`. The two paths' `runs.csv` are identical"
+        + ("" if camp.get("tables_identical") else " (NOT checked)") + ". SciPy's dissipated energy "
+        "at the end of each run is within "
+        + ", ".join(f"{r['energy_dissipated_max_rel_diff_vs_polhode']:.0e} ({m})"
+                    for m, r in camp["scipy"].items())
+        + " of polhode's `energy_dissipated` column, relative: the same draws.",
+    ]
+    return "\n".join(lines)
+
+
 def load_optional(name):
     path = os.path.join(RESULTS, name)
     if not os.path.exists(path):
@@ -277,6 +326,7 @@ def main():
             bsk = json.load(fh)
     bsk_env, pol_env = (load_optional(n) for n in ("basilisk_environment.json",
                                                    "basilisk_environment_polhode.json"))
+    camp = load_optional("campaign.json")
     # Ratios afresh from the runs (so a change of method here needs no re-run).
     sys.path.insert(0, HERE)
     from bench import compute_ratios
@@ -286,7 +336,8 @@ def main():
     blocks = {"versions": block_versions(summary, bsk), "problems": block_problems(summary),
               "refcheck": block_refcheck(summary), "headline": block_headline(summary, runs),
               "target": block_target(summary), "runs": block_runs(summary, runs),
-              "basilisk": block_basilisk(bsk), "environment": block_environment(bsk_env, pol_env)}
+              "campaign": block_campaign(camp), "basilisk": block_basilisk(bsk),
+              "environment": block_environment(bsk_env, pol_env)}
     for name, content in blocks.items():
         text = replace_block(text, name, content)
     with open(DOC, "w") as fh:

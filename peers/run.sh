@@ -10,6 +10,8 @@
 #                                peers/rust-ode compiles polhode's dependencies again: ~9 min)
 #   peers/run.sh --no-basilisk   skip the Basilisk part
 #   peers/run.sh --report-only   regenerate docs/peers.md from peers/results/
+#
+# POLHODE_BIN=PATH uses that polhode binary in peers/campaign.py instead of target/release/polhode.
 set -euo pipefail
 export PYTHONDONTWRITEBYTECODE=1
 cd "$(dirname "$0")"
@@ -44,6 +46,8 @@ if [[ $report_only == 0 ]]; then
   (cd "$PEERS/rust-ode" && CARGO_TARGET_DIR="$PEERS/rust-ode/target" cargo build --release --quiet)
   mkdir -p "$PEERS/results"
   "$VENV/bin/python" "$PEERS/bench.py"
+  # Campaign throughput on one thread: lanes, --no-lanes, SciPy (results/campaign.json).
+  "$VENV/bin/python" "$PEERS/campaign.py"
   if [[ $basilisk == 1 ]]; then
     "$VENV/bin/python" "$PEERS/basilisk_smd.py"
     "$VENV/bin/python" "$PEERS/basilisk_slosh.py"

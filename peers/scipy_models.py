@@ -77,10 +77,12 @@ def quat_rate(q, w):
     ])
 
 
-def multibody_model(module, nq, damping_rate, total_mass, momentum0):
+def multibody_model(module, nq, damping_rate, total_mass, momentum0, derived=None, omega0=None):
     """State [q (4), joint coordinates (nq), generalised speeds u (nu), dissipated energy]
-    from a reference module with derive() -> (fM, fF, fKE), P, OMEGA0, NU and mechanics()."""
-    fM, fF, _ = module.derive()
+    from a reference module with derive() -> (fM, fF, fKE), P, OMEGA0, NU and mechanics().
+    `derived` is (fM, fF) if already derived, `omega0` the hub's initial rate if not OMEGA0."""
+    fM, fF = derived if derived is not None else module.derive()[:2]
+    omega0 = module.OMEGA0 if omega0 is None else np.asarray(omega0, dtype=float)
     nu = module.NU
     iq, ic, iu = 0, 4, 4 + nq
     ie = iu + nu
@@ -103,7 +105,7 @@ def multibody_model(module, nq, damping_rate, total_mass, momentum0):
     v0 = -momentum0 / total_mass
     y0 = np.zeros(n)
     y0[iq] = 1.0
-    y0[iu:iu + nu] = np.concatenate([module.OMEGA0, v0, np.zeros(nu - 6)])
+    y0[iu:iu + nu] = np.concatenate([omega0, v0, np.zeros(nu - 6)])
     return y0, rhs, lambda y: (y[iu:iu + 3], y[iq:iq + 4])
 
 
@@ -120,6 +122,33 @@ def nutation_damper_model(scenario_path):
     c = nd.P["c"]
     p0 = nd.mechanics(0.0, nd.OMEGA0, np.zeros(3), 0.0)["P"]
     return multibody_model(nd, 1, lambda u: c * u[6] ** 2, nd.P["m_bus"] + nd.P["m_p"], p0)
+
+
+_derived = {}
+
+
+def nutation_damper_draw_model(omega0, damping):
+    """The nutation damper of nutation_damper_model with another initial hub rate `omega0`
+    (rad/s, hub axes) and dashpot `damping` (N s/m): one draw of the scenario's campaign.
+    The equations are derived once (sympy, a few seconds) at the reference damping c0. The
+    damping enters Kane's equations only through the generalised active force of the damper's
+    speed, -k rho - c u_rho (nutation_damper.derive asserts this form), so the forcing at c is
+    the forcing at c0 with -(c - c0) u_rho added to that row."""
+    import nutation_damper as nd
+    if "nutation_damper" not in _derived:
+        _derived["nutation_damper"] = nd.derive()[:2]
+    fM, fF0 = _derived["nutation_damper"]
+    dc = float(damping) - nd.P["c"]
+
+    def fF(coords, u):
+        f = list(fF0(coords, u))
+        f[6] -= dc * u[6]
+        return f
+
+    omega0 = np.asarray(omega0, dtype=float)
+    p0 = nd.mechanics(0.0, omega0, np.zeros(3), 0.0)["P"]
+    return multibody_model(nd, 1, lambda u: damping * u[6] ** 2, nd.P["m_bus"] + nd.P["m_p"], p0,
+                           derived=(fM, fF), omega0=omega0)
 
 
 def explorer1_model(scenario_path):
