@@ -429,20 +429,21 @@ impl<L: Lane> Lanes<L> {
         }
     }
 
-    /// Lane `i`'s last accepted step (of an observed integration).
-    fn step_of(&self, i: usize) -> LaneStep {
-        LaneStep {
-            t_prev: self.t_prev.lane(i),
-            t: self.t.lane(i),
-            y: std::array::from_fn(|j| self.y[j].lane(i)),
-            cont: std::array::from_fn(|c| std::array::from_fn(|j| self.cont[c][j].lane(i))),
-            stats: Stats {
-                steps: self.steps.lane(i) as u64,
-                rejected_steps: self.rejected.lane(i) as u64,
-                rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
-                ..Stats::default()
-            },
+    /// Lane `i`'s last accepted step (of an observed integration), into `step`.
+    #[inline(always)]
+    fn step_of(&self, i: usize, step: &mut LaneStep) {
+        step.t_prev = self.t_prev.lane(i);
+        step.t = self.t.lane(i);
+        L::gather_lane(&self.y, i, &mut step.y);
+        for (out, cont) in step.cont.iter_mut().zip(&self.cont) {
+            L::gather_lane(cont, i, out);
         }
+        step.stats = Stats {
+            steps: self.steps.lane(i) as u64,
+            rejected_steps: self.rejected.lane(i) as u64,
+            rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
+            ..Stats::default()
+        };
     }
 
     /// Ends lane `i`'s run as [`LaneStatus::Ended`], whether it was still running or had just
@@ -639,6 +640,13 @@ fn lockstep<L: Lane>(
     let mut lanes = Lanes::<L>::new(first, settings);
     let mut held: Vec<Option<usize>> = vec![None; L::WIDTH];
     let mut next = 0;
+    // The observed lane's step, reused.
+    let mut step = LaneStep::at_end(&LaneOutcome {
+        status: LaneStatus::Complete,
+        t: 0.0,
+        y: [0.0; DIM],
+        stats: Stats::default(),
+    });
     loop {
         // Each free lane takes the next run.
         let mut starting = L::Mask::splat(false);
@@ -676,9 +684,11 @@ fn lockstep<L: Lane>(
                 for (i, slot) in held.iter().enumerate() {
                     if let Some(index) = *slot
                         && accepted.test(i)
-                        && !observe(index, &lanes.step_of(i))
                     {
-                        lanes.end_observed(i);
+                        lanes.step_of(i, &mut step);
+                        if !observe(index, &step) {
+                            lanes.end_observed(i);
+                        }
                     }
                 }
             }

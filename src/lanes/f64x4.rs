@@ -147,6 +147,13 @@ impl Lane for F64x4 {
         self
     }
     #[inline(always)]
+    fn gather_lane(values: &[Self], i: usize, out: &mut [f64]) {
+        // Through references: no copy of each vector to index it.
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v.0[i];
+        }
+    }
+    #[inline(always)]
     fn abs(self) -> Self {
         map(self, f64::abs)
     }

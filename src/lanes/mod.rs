@@ -67,6 +67,13 @@ pub trait Lane:
     fn lane(self, i: usize) -> f64;
     /// A copy with lane `i` set to `x`.
     fn with_lane(self, i: usize, x: f64) -> Self;
+    /// Lane `i` of each of `values`, into `out` (`out[j] = values[j].lane(i)`), read in place.
+    #[inline(always)]
+    fn gather_lane(values: &[Self], i: usize, out: &mut [f64]) {
+        for (o, v) in out.iter_mut().zip(values) {
+            *o = v.lane(i);
+        }
+    }
     /// |x| per lane.
     fn abs(self) -> Self;
     /// √x per lane (correctly rounded, as `f64::sqrt`).
