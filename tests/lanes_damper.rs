@@ -14,8 +14,7 @@ use polhode::effectors::particles::ParticleEffector;
 use polhode::effectors::spring_mass::SpringMass;
 use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
 use polhode::lanes::damper::{
-    DamperRun, Engine, LaneOutcome, LaneSettings, LaneStatus, avx2_available, integrate_runs,
-    integrate_runs_with,
+    DamperRun, Engine, LaneOutcome, LaneSettings, LaneStatus, integrate_runs, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
 use std::time::Instant;
@@ -124,7 +123,7 @@ fn assert_bitwise_equal(engine: Engine, runs: &[DamperRun], lanes: &[LaneOutcome
 
 fn engines() -> Vec<Engine> {
     let mut e = vec![Engine::Scalar, Engine::Portable4];
-    if avx2_available() {
+    if polhode::cpu::avx2_available() {
         e.push(Engine::Avx2);
     }
     e

@@ -15,8 +15,9 @@
 //! scalar `Dopri5` on that run's `Spacecraft`, stepped to the same end time (the tests in
 //! tests/lanes_damper.rs compare them).
 //!
-//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2 and FMA
-//! where the processor has them ([`Engine::Avx2`]), otherwise one lane ([`Engine::Scalar`]).
+//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2
+//! where the processor has it ([`Engine::Avx2`], asked through [`crate::cpu`]), otherwise one
+//! lane ([`Engine::Scalar`]).
 //! [`integrate_runs_observed`] also hands each accepted step of each lane, with its dense
 //! output, to an observer that may end the run: the campaigns' run monitor (samples, events,
 //! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
@@ -160,28 +161,16 @@ pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep) -> bool;
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Engine {
-    /// AVX2 and FMA where the processor has them, else [`Engine::Scalar`].
+    /// AVX2 where the processor has it, else [`Engine::Scalar`].
     Auto,
     /// One lane (`f64`): the same lockstep code at width 1.
     Scalar,
     /// Four lanes ([`F64x4`]) compiled for the baseline target (SSE2 on x86-64): for
     /// comparison only.
     Portable4,
-    /// Four lanes compiled for AVX2 and FMA; falls back to [`Engine::Scalar`] on a processor
-    /// without them.
+    /// Four lanes compiled for AVX2; falls back to [`Engine::Scalar`] on a processor
+    /// without it.
     Avx2,
-}
-
-/// Whether this processor runs [`Engine::Avx2`].
-pub fn avx2_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 /// Integrates every run to its end time with the engine chosen at run time
@@ -223,7 +212,7 @@ pub fn integrate_runs_observed_with(
 /// The engine actually run for `engine` on this processor.
 pub fn resolved(engine: Engine) -> Engine {
     match engine {
-        Engine::Auto | Engine::Avx2 if avx2_available() => Engine::Avx2,
+        Engine::Auto | Engine::Avx2 if crate::cpu::avx2_available() => Engine::Avx2,
         Engine::Auto | Engine::Avx2 => Engine::Scalar,
         e => e,
     }
@@ -239,17 +228,18 @@ fn run_engine(
         Engine::Portable4 => lockstep::<F64x4>(runs, settings, observe),
         #[cfg(target_arch = "x86_64")]
         Engine::Avx2 => {
-            // SAFETY: `resolved` chose AVX2 only where the processor has AVX2 and FMA.
+            // SAFETY: `resolved` chose AVX2 only where the processor has it.
             unsafe { lockstep_avx2(runs, settings, observe) }
         }
         _ => lockstep::<f64>(runs, settings, observe),
     }
 }
 
-/// [`lockstep`] at four lanes, compiled for AVX2 and FMA (everything below is inlined into
-/// it). No `mul_add` is written, so nothing is fused: the bits are the scalar path's.
+/// [`lockstep`] at four lanes, compiled for AVX2 (everything below is inlined into it). No
+/// `mul_add` is written and FMA is not enabled, so nothing is fused: the bits are the scalar
+/// path's.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
 unsafe fn lockstep_avx2(
     runs: &[DamperRun],
     settings: &LaneSettings,

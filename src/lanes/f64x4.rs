@@ -1,7 +1,7 @@
 //! [`F64x4`]: four f64 lanes, and [`M64x4`], their mask.
 //!
 //! Plain arrays with element-wise operations (`std::array::from_fn` over the four lanes): compiled inside a function with
-//! `#[target_feature(enable = "avx2,fma")]` (everything here is `#[inline(always)]`), LLVM
+//! `#[target_feature(enable = "avx2")]` (everything here is `#[inline(always)]`), LLVM
 //! turns each loop into one 256-bit instruction (vaddpd, vmulpd, vdivpd, vsqrtpd, vcmppd, a
 //! blend); compiled for baseline x86-64 it uses two 128-bit SSE2 instructions instead. The
 //! results are the same either way: each lane is rounded as the f64 operation.
