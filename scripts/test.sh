@@ -9,6 +9,9 @@
 # into .venv (tests/python/requirements.txt).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
+# The toolchain rust-toolchain.toml pins is installed by rustup on the first cargo call, also
+# where its automatic installs are turned off (RUSTUP_AUTO_INSTALL=0).
+export RUSTUP_AUTO_INSTALL=1
 
 scripts/python-venv.sh
 cargo fmt --all -- --check
