@@ -120,6 +120,31 @@ pub struct LaneStep {
     pub cont: [[f64; DIM]; 5],
     /// Work so far: accepted and rejected steps, right-hand-side evaluations.
     pub stats: Stats,
+    /// The observation at the end of the step (of an observed integration).
+    pub end: EndObservation,
+}
+
+/// What the run monitor observes at the end of a lane's step, computed in the lanes with the
+/// operations of `Spacecraft::observe` for this class, so that each value is bit for bit the
+/// scalar observation's (the nutation angle and the rest are formed from these per lane).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct EndObservation {
+    /// Attitude, the state's quaternion divided by its norm (w, x, y, z).
+    pub attitude: [f64; 4],
+    /// `|q| − 1`.
+    pub q_norm_error: f64,
+    /// Angular momentum about the system's centre of mass, body axes (N m s).
+    pub h_body: [f64; 3],
+    /// The same in inertial axes (N m s).
+    pub h_inertial: [f64; 3],
+    /// Kinetic energy (J).
+    pub kinetic_energy: f64,
+    /// The spring's elastic energy (J).
+    pub elastic_energy: f64,
+    /// Energy the dashpot has dissipated (J).
+    pub dissipated_energy: f64,
+    /// The dashpot's dissipation rate (W).
+    pub dissipation_power: f64,
 }
 
 impl LaneStep {
@@ -137,6 +162,7 @@ impl LaneStep {
             y: outcome.y,
             cont: [[0.0; DIM]; 5],
             stats: outcome.stats,
+            end: EndObservation::default(),
         }
     }
 }
@@ -281,6 +307,81 @@ impl<L: Lane> System<L> {
     }
 }
 
+/// [`EndObservation`] in lanes.
+struct EndLanes<L: Lane> {
+    attitude: [L; 4],
+    q_norm_error: L,
+    h_body: [L; 3],
+    h_inertial: [L; 3],
+    kinetic_energy: L,
+    elastic_energy: L,
+    dissipated_energy: L,
+    dissipation_power: L,
+}
+
+impl<L: Lane> System<L> {
+    /// The observation at state `y`, with the operations (and their order) of
+    /// `observe::invariants` on a hub with this one damper: nalgebra's `I ω`, dot products
+    /// `(x + y) + z`, its 4-vector norm `(i² + k²) + (j² + w²)` and its rotation
+    /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
+    /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0).
+    #[inline(always)]
+    fn observe(&self, y: &[L; DIM]) -> EndLanes<L> {
+        use linalg::cross;
+        let zero = L::splat(0.0);
+        let half = L::splat(0.5);
+        let w = [y[0], y[1], y[2]];
+        let (qw, qi, qj, qk) = (y[3], y[4], y[5], y[6]);
+        let q_norm = ((qi * qi + qk * qk) + (qj * qj + qw * qw)).sqrt();
+        let attitude = [qw / q_norm, qi / q_norm, qj / q_norm, qk / q_norm];
+        let i = &self.hub_inertia;
+        // hub_inertia[c][r] is I(r, c).
+        let iw: [L; 3] = std::array::from_fn(|r| i[0][r] * w[0] + i[1][r] * w[1] + i[2][r] * w[2]);
+        let mut h = iw;
+        let mut kinetic = half * (w[0] * iw[0] + w[1] * iw[1] + w[2] * iw[2]);
+        let d = &self.damper;
+        let (q, u) = (y[7], y[8]);
+        let m = d.mass;
+        let r: [L; 3] = std::array::from_fn(|k| d.position[k] + q * d.direction[k]);
+        let wr = cross(w, r);
+        let v: [L; 3] = std::array::from_fn(|k| wr[k] + u * d.direction[k]);
+        let rv = cross(r, v);
+        let mass = self.hub_mass + m;
+        let first_moment: [L; 3] = std::array::from_fn(|k| zero + m * r[k]);
+        let linear: [L; 3] = std::array::from_fn(|k| zero + m * v[k]);
+        for k in 0..3 {
+            h[k] += m * rv[k];
+        }
+        kinetic += half * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        // The hub moves at −P/M when the particles carry linear momentum.
+        let moving = mass.greater_than(zero)
+            & !(linear[0].equals(zero) & linear[1].equals(zero) & linear[2].equals(zero));
+        let v_hub: [L; 3] = std::array::from_fn(|k| -linear[k] / mass);
+        let c = cross(first_moment, v_hub);
+        for k in 0..3 {
+            h[k] = L::select(moving, h[k] + c[k], h[k]);
+        }
+        let lin2 = linear[0] * linear[0] + linear[1] * linear[1] + linear[2] * linear[2];
+        kinetic = L::select(moving, kinetic - half * lin2 / mass, kinetic);
+        let axis = [attitude[1], attitude[2], attitude[3]];
+        let two = L::splat(2.0);
+        let t = cross(axis, h);
+        let t = [t[0] * two, t[1] * two, t[2] * two];
+        let ut = cross(axis, t);
+        let h_inertial: [L; 3] = std::array::from_fn(|k| t[k] * attitude[0] + ut[k] + h[k]);
+        EndLanes {
+            attitude,
+            q_norm_error: q_norm - L::splat(1.0),
+            h_body: h,
+            h_inertial,
+            kinetic_energy: kinetic,
+            elastic_energy: zero + half * d.stiffness * q * q,
+            dissipated_energy: zero + y[9],
+            dissipation_power: zero + d.damping * u * u,
+        }
+    }
+}
+
 /// The system as the stages' right-hand side, noting the lanes whose closed form was solved
 /// at every stage.
 struct Solving<'a, L: Lane> {
@@ -315,6 +416,8 @@ struct Lanes<L: Lane> {
     k: [[L; DIM]; 7],
     /// Dense-output coefficients of the last accepted step, when observed.
     cont: [[L; DIM]; 5],
+    /// The observation at the end of the last accepted step, when observed.
+    end: Option<EndLanes<L>>,
     /// Work counters, as exact integers in f64.
     steps: L,
     rejected: L,
@@ -358,6 +461,7 @@ impl<L: Lane> Lanes<L> {
             stage: [z; DIM],
             k: [[z; DIM]; 7],
             cont: [[z; DIM]; 5],
+            end: None,
             steps: z,
             rejected: z,
             rhs_evaluations: z,
@@ -427,6 +531,17 @@ impl<L: Lane> Lanes<L> {
         L::gather_lane(&self.y, i, &mut step.y);
         for (out, cont) in step.cont.iter_mut().zip(&self.cont) {
             L::gather_lane(cont, i, out);
+        }
+        if let Some(e) = &self.end {
+            let o = &mut step.end;
+            L::gather_lane(&e.attitude, i, &mut o.attitude);
+            L::gather_lane(&e.h_body, i, &mut o.h_body);
+            L::gather_lane(&e.h_inertial, i, &mut o.h_inertial);
+            o.q_norm_error = e.q_norm_error.lane(i);
+            o.kinetic_energy = e.kinetic_energy.lane(i);
+            o.elastic_energy = e.elastic_energy.lane(i);
+            o.dissipated_energy = e.dissipated_energy.lane(i);
+            o.dissipation_power = e.dissipation_power.lane(i);
         }
         step.stats = Stats {
             steps: self.steps.lane(i) as u64,
@@ -586,6 +701,9 @@ impl<L: Lane> Lanes<L> {
             self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
         }
         self.t = L::select(accept, end.t_new, self.t);
+        if observed && accept.any() {
+            self.end = Some(self.system.observe(&self.y));
+        }
         self.steps += L::select(accept, one, zero);
         self.rejected += L::select(reject, one, zero);
         self.rejected_in_a_row = L::select(

@@ -15,7 +15,8 @@ use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
     DIM, DamperRun, Engine, LaneSettings, LaneStatus, LaneStep, integrate_runs_observed_with,
 };
-use crate::model::Spacecraft;
+use crate::model::{Observation, Spacecraft, angle_between};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -40,6 +41,37 @@ impl StepView for LaneView<'_> {
     }
     fn stats(&self) -> Stats {
         self.0.stats
+    }
+    fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
+        let step = self.0;
+        let e = &step.end;
+        let omega = Vector3::new(step.y[0], step.y[1], step.y[2]);
+        let [w, i, j, k] = e.attitude;
+        let h_body = Vector3::from(e.h_body);
+        Some(Observation {
+            t: step.t,
+            omega,
+            attitude: UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
+            q_norm_error: e.q_norm_error,
+            h_body,
+            h_inertial: Vector3::from(e.h_inertial),
+            h_norm: h_body.norm(),
+            h_carried_out: Vector3::zeros(),
+            kinetic_energy: e.kinetic_energy,
+            elastic_energy: e.elastic_energy,
+            dissipated_energy: e.dissipated_energy,
+            dissipation_power: e.dissipation_power,
+            // The scalar sum of the works starts from zero and adds the damper's zero.
+            external_work: 0.0,
+            nutation_angle: angle_between(&sc.spin_axis, &h_body),
+            angles_to_principal: if angles {
+                sc.angles_to_principal(&omega)
+            } else {
+                [f64::NAN; 3]
+            },
+            // The class has no magnet.
+            field_angle: f64::NAN,
+        })
     }
 }
 
@@ -158,6 +190,7 @@ pub fn run_in_lanes<S: Sink + Default>(
                 y: y0,
                 cont: [[0.0; DIM]; 5],
                 stats: Stats::default(),
+                end: Default::default(),
             };
             let outcome = monitor.finish(&LaneView(&start), status, &mut sink)?;
             results[index] = Some((outcome, sink));

@@ -29,6 +29,11 @@ pub(crate) trait StepView {
     fn prepare_interpolation(&mut self, sc: &Spacecraft) -> bool;
     /// Work so far.
     fn stats(&self) -> Stats;
+    /// The observation at the end of the step, if the integrator made it already (as
+    /// `Spacecraft::observe_for_events(t, y, angles)` would, bit for bit).
+    fn end_observation(&self, _sc: &Spacecraft, _angles: bool) -> Option<Observation> {
+        None
+    }
 }
 
 impl<M: Stepper> StepView for M {
@@ -278,7 +283,11 @@ impl<'a> Monitor<'a> {
         let o1 = if watches.is_empty() {
             None
         } else {
-            Some(observe_for_events(t1, stepper.y()))
+            Some(
+                stepper
+                    .end_observation(sc, watched_angles)
+                    .unwrap_or_else(|| observe_for_events(t1, stepper.y())),
+            )
         };
         let step_invariants = match &o1 {
             Some(o) => o.invariants(),
