@@ -14,7 +14,8 @@ use polhode::effectors::particles::ParticleEffector;
 use polhode::effectors::spring_mass::SpringMass;
 use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
 use polhode::lanes::damper::{
-    DamperRun, Engine, LaneOutcome, LaneSettings, LaneStatus, integrate_runs, integrate_runs_with,
+    DamperRun, Engine, LaneObservation, LaneOutcome, LaneSettings, LaneStatus, integrate_runs,
+    integrate_runs_observed_with, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
 use std::time::Instant;
@@ -79,6 +80,7 @@ fn dispersed_runs(count: usize, seed: u64, t_end: impl Fn(usize) -> f64) -> Vec<
             offset0: d.uniform(-0.05, 0.05),
             rate0: d.uniform(-0.02, 0.02),
             t_end: t_end(i),
+            sample_rate: 0.0,
         })
         .collect()
 }
@@ -127,6 +129,96 @@ fn engines() -> Vec<Engine> {
         e.push(Engine::Avx2);
     }
     e
+}
+
+/// `lane`'s values against the scalar observation of `sc` at (`t`, `y`), bit for bit.
+fn assert_observed_as_scalar(
+    sc: &Spacecraft,
+    t: f64,
+    y: &[f64],
+    lane: &LaneObservation,
+    what: &str,
+) {
+    let o = sc.observe(t, y);
+    let q = o.attitude.quaternion();
+    let pairs = [
+        ("attitude w", lane.attitude[0], q.w),
+        ("attitude x", lane.attitude[1], q.i),
+        ("attitude y", lane.attitude[2], q.j),
+        ("attitude z", lane.attitude[3], q.k),
+        ("|q| - 1", lane.q_norm_error, o.q_norm_error),
+        ("H body x", lane.h_body[0], o.h_body.x),
+        ("H body y", lane.h_body[1], o.h_body.y),
+        ("H body z", lane.h_body[2], o.h_body.z),
+        ("H inertial x", lane.h_inertial[0], o.h_inertial.x),
+        ("H inertial y", lane.h_inertial[1], o.h_inertial.y),
+        ("H inertial z", lane.h_inertial[2], o.h_inertial.z),
+        ("kinetic", lane.kinetic_energy, o.kinetic_energy),
+        ("elastic", lane.elastic_energy, o.elastic_energy),
+        ("dissipated", lane.dissipated_energy, o.dissipated_energy),
+        ("power", lane.dissipation_power, o.dissipation_power),
+    ];
+    for (name, a, b) in pairs {
+        assert_eq!(a.to_bits(), b.to_bits(), "{what}, {name}: {a} vs {b}");
+    }
+}
+
+/// An observed integration hands each step's end observation and, where the output grid has a
+/// time strictly inside the step, the state there and its observation: each bit for bit what
+/// the scalar interpolation and `Spacecraft::observe` give. Every grid time is either a step's
+/// end, its first grid time inside, or a further one inside the same step (left to the
+/// observer); the test counts them so that the handed samples cannot be silently absent.
+#[test]
+fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
+    let rate = 20.0;
+    let mut runs = dispersed_runs(6, 11, |i| 20.0 + 3.0 * i as f64);
+    for run in &mut runs {
+        run.sample_rate = rate;
+    }
+    let craft: Vec<Spacecraft> = runs.iter().map(spacecraft).collect();
+    for engine in engines() {
+        // Per run: grid times handed inside steps, at step ends, and left over.
+        let mut counts = vec![(0u64, 0u64, 0u64); runs.len()];
+        let mut buf = [0.0; 10];
+        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step| {
+            let sc = &craft[k];
+            let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
+            assert_observed_as_scalar(sc, step.t, &step.y, &step.end, &what);
+            // The grid times in (t_prev, t].
+            let first = (step.t_prev * rate).floor() as u64 + 1;
+            let grid: Vec<f64> = (first..)
+                .map(|j| j as f64 / rate)
+                .skip_while(|&tk| tk <= step.t_prev)
+                .take_while(|&tk| tk <= step.t)
+                .collect();
+            let inside: Vec<f64> = grid.iter().copied().filter(|&tk| tk < step.t).collect();
+            match (&step.sample, inside.first()) {
+                (Some(s), Some(&tk)) => {
+                    assert_eq!(s.t.to_bits(), tk.to_bits(), "{what}: sample time");
+                    step.interpolate(tk, &mut buf);
+                    for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
+                        assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
+                    }
+                    assert_observed_as_scalar(sc, tk, &s.y, &s.observation, &what);
+                    counts[k].0 += 1;
+                    counts[k].2 += inside.len() as u64 - 1;
+                }
+                (None, None) => {}
+                (s, tk) => panic!("{what}: sample {s:?} for the grid time {tk:?}"),
+            }
+            counts[k].1 += (grid.len() - inside.len()) as u64;
+            true
+        });
+        for (k, (run, &(inside, at_end, left))) in runs.iter().zip(&counts).enumerate() {
+            // Every grid time in (0, t_end] is accounted for once.
+            let whole = (run.t_end * rate).floor() as u64;
+            assert_eq!(inside + at_end + left, whole, "{engine:?}, run {k}");
+            assert!(
+                inside > whole / 2,
+                "{engine:?}, run {k}: {inside} of {whole} handed"
+            );
+        }
+    }
 }
 
 /// 12 dispersed draws to 60 s, all ending together: three full lanes of four.

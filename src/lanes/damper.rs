@@ -55,6 +55,10 @@ pub struct DamperRun {
     pub rate0: f64,
     /// End time (s); the run starts at t = 0.
     pub t_end: f64,
+    /// Rate of the output grid k / `sample_rate` (Hz) on which an observed integration also
+    /// hands the observer the state and its observation at the step's first grid time
+    /// ([`LaneStep::sample`]); 0: none.
+    pub sample_rate: f64,
 }
 
 impl DamperRun {
@@ -108,7 +112,7 @@ pub enum LaneStatus {
 
 /// An accepted step of one lane, as [`integrate_runs_observed`] hands it to its observer: the
 /// step's ends and the coefficients of its dense output (those of the scalar `Dopri5`).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct LaneStep {
     /// Start of the step (s).
     pub t_prev: f64,
@@ -121,30 +125,65 @@ pub struct LaneStep {
     /// Work so far: accepted and rejected steps, right-hand-side evaluations.
     pub stats: Stats,
     /// The observation at the end of the step (of an observed integration).
-    pub end: EndObservation,
+    pub end: LaneObservation,
+    /// The first time of the run's output grid strictly inside the step, if there is one, with
+    /// the state there and its observation (of an observed integration).
+    pub sample: Option<LaneSample>,
 }
 
-/// What the run monitor observes at the end of a lane's step, computed in the lanes with the
-/// operations of `Spacecraft::observe` for this class, so that each value is bit for bit the
-/// scalar observation's (the nutation angle and the rest are formed from these per lane).
+/// The state at one time of the output grid inside a step, from the step's dense output (as
+/// [`LaneStep::interpolate`] gives it), and its observation.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneSample {
+    /// The grid time (s): k / `sample_rate`.
+    pub t: f64,
+    /// The state there.
+    pub y: [f64; DIM],
+    /// Its observation.
+    pub observation: LaneObservation,
+}
+
+/// What the run monitor observes of a lane's state, computed in the lanes with the operations
+/// of `Spacecraft::observe` for this class, so that each value is bit for bit the scalar
+/// observation's (the nutation angle and the rest are formed from these per lane). `T` is one
+/// value ([`f64`]) or one per lane.
 #[derive(Debug, Clone, Copy, Default)]
-pub struct EndObservation {
+pub struct LaneObservation<T = f64> {
     /// Attitude, the state's quaternion divided by its norm (w, x, y, z).
-    pub attitude: [f64; 4],
+    pub attitude: [T; 4],
     /// `|q| − 1`.
-    pub q_norm_error: f64,
+    pub q_norm_error: T,
     /// Angular momentum about the system's centre of mass, body axes (N m s).
-    pub h_body: [f64; 3],
+    pub h_body: [T; 3],
     /// The same in inertial axes (N m s).
-    pub h_inertial: [f64; 3],
+    pub h_inertial: [T; 3],
     /// Kinetic energy (J).
-    pub kinetic_energy: f64,
+    pub kinetic_energy: T,
     /// The spring's elastic energy (J).
-    pub elastic_energy: f64,
+    pub elastic_energy: T,
     /// Energy the dashpot has dissipated (J).
-    pub dissipated_energy: f64,
+    pub dissipated_energy: T,
     /// The dashpot's dissipation rate (W).
-    pub dissipation_power: f64,
+    pub dissipation_power: T,
+}
+
+impl<L: Lane> LaneObservation<L> {
+    /// Lane `i`'s values.
+    #[inline(always)]
+    fn lane(&self, i: usize) -> LaneObservation {
+        let mut o = LaneObservation {
+            q_norm_error: self.q_norm_error.lane(i),
+            kinetic_energy: self.kinetic_energy.lane(i),
+            elastic_energy: self.elastic_energy.lane(i),
+            dissipated_energy: self.dissipated_energy.lane(i),
+            dissipation_power: self.dissipation_power.lane(i),
+            ..LaneObservation::default()
+        };
+        L::gather_lane(&self.attitude, i, &mut o.attitude);
+        L::gather_lane(&self.h_body, i, &mut o.h_body);
+        L::gather_lane(&self.h_inertial, i, &mut o.h_inertial);
+        o
+    }
 }
 
 impl LaneStep {
@@ -160,9 +199,8 @@ impl LaneStep {
             t_prev: outcome.t,
             t: outcome.t,
             y: outcome.y,
-            cont: [[0.0; DIM]; 5],
             stats: outcome.stats,
-            end: EndObservation::default(),
+            ..LaneStep::default()
         }
     }
 }
@@ -307,18 +345,6 @@ impl<L: Lane> System<L> {
     }
 }
 
-/// [`EndObservation`] in lanes.
-struct EndLanes<L: Lane> {
-    attitude: [L; 4],
-    q_norm_error: L,
-    h_body: [L; 3],
-    h_inertial: [L; 3],
-    kinetic_energy: L,
-    elastic_energy: L,
-    dissipated_energy: L,
-    dissipation_power: L,
-}
-
 impl<L: Lane> System<L> {
     /// The observation at state `y`, with the operations (and their order) of
     /// `observe::invariants` on a hub with this one damper: nalgebra's `I ω`, dot products
@@ -326,7 +352,7 @@ impl<L: Lane> System<L> {
     /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
     /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0).
     #[inline(always)]
-    fn observe(&self, y: &[L; DIM]) -> EndLanes<L> {
+    fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
         use linalg::cross;
         let zero = L::splat(0.0);
         let half = L::splat(0.5);
@@ -369,7 +395,7 @@ impl<L: Lane> System<L> {
         let t = [t[0] * two, t[1] * two, t[2] * two];
         let ut = cross(axis, t);
         let h_inertial: [L; 3] = std::array::from_fn(|k| t[k] * attitude[0] + ut[k] + h[k]);
-        EndLanes {
+        LaneObservation {
             attitude,
             q_norm_error: q_norm - L::splat(1.0),
             h_body: h,
@@ -396,6 +422,14 @@ impl<L: Lane> StageRhs<L> for Solving<'_, L> {
     }
 }
 
+/// [`LaneSample`] in lanes, for the lanes of `due`.
+struct SampleLanes<L: Lane> {
+    due: L::Mask,
+    t: L,
+    y: [L; DIM],
+    observation: LaneObservation<L>,
+}
+
 /// The lanes' integration state: each field holds one value per lane.
 struct Lanes<L: Lane> {
     system: System<L>,
@@ -417,7 +451,14 @@ struct Lanes<L: Lane> {
     /// Dense-output coefficients of the last accepted step, when observed.
     cont: [[L; DIM]; 5],
     /// The observation at the end of the last accepted step, when observed.
-    end: Option<EndLanes<L>>,
+    end: Option<LaneObservation<L>>,
+    /// Each run's output grid (Hz; 0: none) and the index k of its next grid time
+    /// k / rate after the last accepted step's end, when observed.
+    sample_rate: L,
+    next_sample: L,
+    /// The lanes whose last accepted step holds a grid time strictly inside it, with that
+    /// time, the state there and its observation, when observed.
+    sample: Option<SampleLanes<L>>,
     /// Work counters, as exact integers in f64.
     steps: L,
     rejected: L,
@@ -462,6 +503,9 @@ impl<L: Lane> Lanes<L> {
             k: [[z; DIM]; 7],
             cont: [[z; DIM]; 5],
             end: None,
+            sample_rate: z,
+            next_sample: z,
+            sample: None,
             steps: z,
             rejected: z,
             rhs_evaluations: z,
@@ -498,6 +542,15 @@ impl<L: Lane> Lanes<L> {
         }
         set(&mut self.t, 0.0);
         set(&mut self.t_end, run.t_end);
+        // Finite and non-negative, or no grid.
+        let rate = if run.sample_rate > 0.0 && run.sample_rate.is_finite() {
+            run.sample_rate
+        } else {
+            0.0
+        };
+        set(&mut self.sample_rate, rate);
+        // The monitor samples t = 0 itself at the start.
+        set(&mut self.next_sample, 1.0);
         set(&mut self.h, 0.0);
         set(&mut self.fac_old, 1e-4);
         set(&mut self.steps, 0.0);
@@ -533,16 +586,25 @@ impl<L: Lane> Lanes<L> {
             L::gather_lane(cont, i, out);
         }
         if let Some(e) = &self.end {
-            let o = &mut step.end;
-            L::gather_lane(&e.attitude, i, &mut o.attitude);
-            L::gather_lane(&e.h_body, i, &mut o.h_body);
-            L::gather_lane(&e.h_inertial, i, &mut o.h_inertial);
-            o.q_norm_error = e.q_norm_error.lane(i);
-            o.kinetic_energy = e.kinetic_energy.lane(i);
-            o.elastic_energy = e.elastic_energy.lane(i);
-            o.dissipated_energy = e.dissipated_energy.lane(i);
-            o.dissipation_power = e.dissipation_power.lane(i);
+            step.end = e.lane(i);
         }
+        step.sample = match &self.sample {
+            Some(SampleLanes {
+                due,
+                t,
+                y,
+                observation,
+            }) if due.test(i) => {
+                let mut sample = LaneSample {
+                    t: t.lane(i),
+                    y: [0.0; DIM],
+                    observation: observation.lane(i),
+                };
+                L::gather_lane(y, i, &mut sample.y);
+                Some(sample)
+            }
+            _ => None,
+        };
         step.stats = Stats {
             steps: self.steps.lane(i) as u64,
             rejected_steps: self.rejected.lane(i) as u64,
@@ -629,6 +691,48 @@ impl<L: Lane> Lanes<L> {
         }
     }
 
+    /// For the lanes of `accepted` that have just taken a step: the first time of the run's
+    /// output grid strictly inside it, the state there by the step's dense output (the
+    /// operations of `dopri5::dense_value`) and its observation; then the next grid index
+    /// past the step's end, as the run monitor advances it when it samples up to there. A
+    /// grid time at the step's end is the end observation, and a second one inside the same
+    /// step is left to the monitor.
+    #[inline(always)]
+    fn sample_inside(&mut self, accepted: L::Mask) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let gridded = accepted & self.sample_rate.greater_than(zero);
+        let t_k = self.next_sample / self.sample_rate;
+        let due = gridded & t_k.less_than(self.t);
+        self.sample = if due.any() {
+            let h = self.t - self.t_prev;
+            let theta = (t_k - self.t_prev) / h;
+            let theta1 = one - theta;
+            let [c1, c2, c3, c4, c5] = &self.cont;
+            // A loop, not `array::from_fn`, whose closure would be compiled outside the AVX2
+            // build.
+            let mut y = [zero; DIM];
+            for j in 0..DIM {
+                y[j] =
+                    c1[j] + theta * (c2[j] + theta1 * (c3[j] + theta * (c4[j] + theta1 * c5[j])));
+            }
+            Some(SampleLanes {
+                due,
+                t: t_k,
+                y,
+                observation: self.system.observe(&y),
+            })
+        } else {
+            None
+        };
+        loop {
+            let passed = gridded & (self.next_sample / self.sample_rate).at_most(self.t);
+            if !passed.any() {
+                break;
+            }
+            self.next_sample += L::select(passed, one, zero);
+        }
+    }
+
     /// One attempted step in every running lane, accepted or rejected lane by lane, as the
     /// scalar `Dopri5::step` takes it; returns the lanes that accepted. With `observed`, the
     /// accepted steps' dense output is kept.
@@ -703,6 +807,7 @@ impl<L: Lane> Lanes<L> {
         self.t = L::select(accept, end.t_new, self.t);
         if observed && accept.any() {
             self.end = Some(self.system.observe(&self.y));
+            self.sample_inside(accept);
         }
         self.steps += L::select(accept, one, zero);
         self.rejected += L::select(reject, one, zero);
@@ -749,12 +854,7 @@ fn lockstep<L: Lane>(
     let mut held: Vec<Option<usize>> = vec![None; L::WIDTH];
     let mut next = 0;
     // The observed lane's step, reused.
-    let mut step = LaneStep::at_end(&LaneOutcome {
-        status: LaneStatus::Complete,
-        t: 0.0,
-        y: [0.0; DIM],
-        stats: Stats::default(),
-    });
+    let mut step = LaneStep::default();
     loop {
         // Each free lane takes the next run.
         let mut starting = L::Mask::splat(false);

@@ -173,29 +173,46 @@ pub(super) fn angles_to_principal(sc: &Spacecraft, omega: &Vector3<f64>) -> [f64
 /// The observation at state `y`; its angles to the principal axes are NaN unless `angles`.
 pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64], angles: bool) -> Observation {
     let (inv, attitude) = invariants(sc, t, y);
-    let omega = Vector3::new(y[0], y[1], y[2]);
-    let angles_to_principal = if angles {
-        angles_to_principal(sc, &omega)
-    } else {
-        [f64::NAN; 3]
-    };
-    Observation {
-        t,
-        omega,
-        attitude,
-        q_norm_error: inv.q_norm_error,
-        h_body: inv.h_body,
-        h_inertial: inv.h_inertial,
-        h_norm: inv.h_body.norm(),
-        h_carried_out: inv.h_carried_out,
-        kinetic_energy: inv.kinetic_energy,
-        elastic_energy: inv.elastic_energy,
-        dissipated_energy: inv.dissipated_energy,
-        dissipation_power: inv.dissipation_power,
-        external_work: inv.external_work,
-        nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
-        angles_to_principal,
-        field_angle: field_angle(sc, t, y),
+    Observation::from_invariants(sc, t, y, &inv, attitude, angles)
+}
+
+impl Observation {
+    /// The observation of `sc` at state `y` (time `t`, s) whose invariants and attitude are
+    /// already known (as [`Spacecraft::invariants`] gives them, or the same computed
+    /// elsewhere bit for bit): the rest is derived here. Its angles to the principal axes are
+    /// NaN unless `angles`.
+    pub(crate) fn from_invariants(
+        sc: &Spacecraft,
+        t: f64,
+        y: &[f64],
+        inv: &Invariants,
+        attitude: UnitQuaternion<f64>,
+        angles: bool,
+    ) -> Observation {
+        let omega = Vector3::new(y[0], y[1], y[2]);
+        let angles_to_principal = if angles {
+            angles_to_principal(sc, &omega)
+        } else {
+            [f64::NAN; 3]
+        };
+        Observation {
+            t,
+            omega,
+            attitude,
+            q_norm_error: inv.q_norm_error,
+            h_body: inv.h_body,
+            h_inertial: inv.h_inertial,
+            h_norm: inv.h_body.norm(),
+            h_carried_out: inv.h_carried_out,
+            kinetic_energy: inv.kinetic_energy,
+            elastic_energy: inv.elastic_energy,
+            dissipated_energy: inv.dissipated_energy,
+            dissipation_power: inv.dissipation_power,
+            external_work: inv.external_work,
+            nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
+            angles_to_principal,
+            field_angle: field_angle(sc, t, y),
+        }
     }
 }
 

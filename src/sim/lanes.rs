@@ -13,9 +13,10 @@ use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
-    DIM, DamperRun, Engine, LaneSettings, LaneStatus, LaneStep, integrate_runs_observed_with,
+    DIM, DamperRun, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
+    integrate_runs_observed_with,
 };
-use crate::model::{Observation, Spacecraft, angle_between};
+use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -44,35 +45,49 @@ impl StepView for LaneView<'_> {
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
         let step = self.0;
-        let e = &step.end;
-        let omega = Vector3::new(step.y[0], step.y[1], step.y[2]);
-        let [w, i, j, k] = e.attitude;
-        let h_body = Vector3::from(e.h_body);
-        Some(Observation {
-            t: step.t,
-            omega,
-            attitude: UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k)),
-            q_norm_error: e.q_norm_error,
-            h_body,
-            h_inertial: Vector3::from(e.h_inertial),
-            h_norm: h_body.norm(),
-            h_carried_out: Vector3::zeros(),
-            kinetic_energy: e.kinetic_energy,
-            elastic_energy: e.elastic_energy,
-            dissipated_energy: e.dissipated_energy,
-            dissipation_power: e.dissipation_power,
-            // The scalar sum of the works starts from zero and adds the damper's zero.
-            external_work: 0.0,
-            nutation_angle: angle_between(&sc.spin_axis, &h_body),
-            angles_to_principal: if angles {
-                sc.angles_to_principal(&omega)
-            } else {
-                [f64::NAN; 3]
-            },
-            // The class has no magnet.
-            field_angle: f64::NAN,
-        })
+        Some(observation(sc, step.t, &step.y, &step.end, angles))
     }
+    fn observe_at(
+        &self,
+        t: f64,
+        sc: &Spacecraft,
+        angles: bool,
+        out: &mut [f64],
+    ) -> Option<Observation> {
+        let sample = self.0.sample.as_ref()?;
+        if sample.t.to_bits() != t.to_bits() {
+            return None;
+        }
+        out.copy_from_slice(&sample.y);
+        Some(observation(sc, t, &sample.y, &sample.observation, angles))
+    }
+}
+
+/// The run monitor's observation of a lane's state `y` at `t` (s) from what the lanes computed
+/// of it (`lane`), as `Spacecraft::observe_for_events(t, y, angles)` would give it.
+fn observation(
+    sc: &Spacecraft,
+    t: f64,
+    y: &[f64],
+    lane: &LaneObservation,
+    angles: bool,
+) -> Observation {
+    let [w, i, j, k] = lane.attitude;
+    let invariants = Invariants {
+        h_body: Vector3::from(lane.h_body),
+        h_inertial: Vector3::from(lane.h_inertial),
+        // The class carries nothing out and has no external torque: the scalar sums start
+        // from zero and stay there.
+        h_carried_out: Vector3::zeros(),
+        kinetic_energy: lane.kinetic_energy,
+        elastic_energy: lane.elastic_energy,
+        dissipated_energy: lane.dissipated_energy,
+        dissipation_power: lane.dissipation_power,
+        external_work: 0.0,
+        q_norm_error: lane.q_norm_error,
+    };
+    let attitude = UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k));
+    Observation::from_invariants(sc, t, y, &invariants, attitude, angles)
 }
 
 /// `sim` as a run of the lanes' nutation-damper class and the integration settings it needs,
@@ -125,6 +140,7 @@ pub fn lane_form(sim: &Simulation) -> Result<(DamperRun, LaneSettings), String> 
         offset0: y0.get(7).copied().unwrap_or(f64::NAN),
         rate0: y0.get(8).copied().unwrap_or(f64::NAN),
         t_end: sim.duration,
+        sample_rate: sim.output_rate,
     };
     let same_start = y0.len() == DIM
         && run
@@ -185,12 +201,8 @@ pub fn run_in_lanes<S: Sink + Default>(
         if status.is_some() || !steps_ahead {
             // Ended at t = 0, as the scalar loop does without a step.
             let start = LaneStep {
-                t_prev: 0.0,
-                t: 0.0,
                 y: y0,
-                cont: [[0.0; DIM]; 5],
-                stats: Stats::default(),
-                end: Default::default(),
+                ..LaneStep::default()
             };
             let outcome = monitor.finish(&LaneView(&start), status, &mut sink)?;
             results[index] = Some((outcome, sink));

@@ -34,6 +34,18 @@ pub(crate) trait StepView {
     fn end_observation(&self, _sc: &Spacecraft, _angles: bool) -> Option<Observation> {
         None
     }
+    /// The state at `t` inside the step into `out` and its observation, if the integrator
+    /// made them already (as `interpolate(t, out)` and then
+    /// `Spacecraft::observe_for_events(t, out, angles)` would, bit for bit).
+    fn observe_at(
+        &self,
+        _t: f64,
+        _sc: &Spacecraft,
+        _angles: bool,
+        _out: &mut [f64],
+    ) -> Option<Observation> {
+        None
+    }
 }
 
 impl<M: Stepper> StepView for M {
@@ -452,6 +464,8 @@ impl<'a> Monitor<'a> {
                             },
                             None => sc.observe_for_events(t1, buf, sample_angles),
                         }
+                    } else if let Some(o) = stepper.observe_at(tk, sc, sample_angles, buf) {
+                        o
                     } else {
                         stepper.interpolate(tk, buf);
                         sc.observe_for_events(tk, buf, sample_angles)
