@@ -108,6 +108,12 @@ pub(crate) struct Monitor<'a> {
     last_obs: Observation,
     /// Event-check points of the current step: (time, observation).
     grid: Vec<(f64, Observation)>,
+    /// Each watch's margin at each point of `grid`, point by point (`grid[p]`'s margins at
+    /// `p * watches.len()..`): each margin computed once.
+    grid_margins: Vec<f64>,
+    /// Each watch's margin at `prev`, and at the current step's end.
+    prev_margins: Vec<f64>,
+    end_margins: Vec<f64>,
     /// Each condition's margin at the start of the last step, and that step's size (s), for
     /// `far_from_crossing`; NaN: not known (the first step, or after a breakpoint).
     margins_before: Vec<f64>,
@@ -192,6 +198,7 @@ impl<'a> Monitor<'a> {
             status = Some(s);
         }
         let n_watches = watches.len();
+        let prev_margins = watches.iter().map(|w| w.condition.margin(&o0)).collect();
         let monitor = Monitor {
             started,
             sim,
@@ -215,6 +222,9 @@ impl<'a> Monitor<'a> {
             next_k: 1,
             last_sample_t: 0.0,
             grid: Vec::with_capacity(interior_checks + 2),
+            grid_margins: Vec::with_capacity((interior_checks + 2) * n_watches),
+            prev_margins,
+            end_margins: Vec::with_capacity(n_watches),
             margins_before: vec![f64::NAN; n_watches],
             h_before: 0.0,
             last_good: None,
@@ -260,6 +270,9 @@ impl<'a> Monitor<'a> {
             ref mut prev,
             ref mut last_obs,
             ref mut grid,
+            ref mut grid_margins,
+            ref mut prev_margins,
+            ref mut end_margins,
             ref mut margins_before,
             ref mut h_before,
             ref mut last_good,
@@ -374,8 +387,15 @@ impl<'a> Monitor<'a> {
             // is not needed.
             let h = t1 - t0;
             let mut near = false;
-            for (watch, g_before) in watches.iter().zip(margins_before.iter_mut()) {
-                let (ga, gb) = (watch.condition.margin(prev), watch.condition.margin(o1));
+            let n_watches = watches.len();
+            end_margins.clear();
+            end_margins.extend(watches.iter().map(|w| w.condition.margin(o1)));
+            for (((watch, g_before), &ga), &gb) in watches
+                .iter()
+                .zip(margins_before.iter_mut())
+                .zip(prev_margins.iter())
+                .zip(end_margins.iter())
+            {
                 near |= watch.active() && !far_from_crossing(*g_before, ga, gb, *h_before, h);
                 *g_before = ga;
             }
@@ -386,27 +406,37 @@ impl<'a> Monitor<'a> {
             }
             // Reused across steps: no allocation per step once it has grown.
             grid.clear();
+            grid_margins.clear();
             grid.push((t0, prev.clone()));
+            grid_margins.extend_from_slice(prev_margins);
             for j in 1..=checks {
                 let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
                 stepper.interpolate(t, buf);
-                grid.push((t, observe_for_events(t, buf)));
+                let o = observe_for_events(t, buf);
+                grid_margins.extend(watches.iter().map(|w| w.condition.margin(&o)));
+                grid.push((t, o));
             }
             grid.push((t1, o1.clone()));
+            grid_margins.extend_from_slice(end_margins);
+            std::mem::swap(prev_margins, end_margins);
+            let margin_at = |p: usize, w: usize| grid_margins[p * n_watches + w];
             // A sign change is located on the dense output.
-            let bracketed = watches.iter().filter(|w| w.active()).any(|w| {
-                grid.windows(2).any(|p| {
-                    (w.condition.margin(&p[0].1) > 0.0) != (w.condition.margin(&p[1].1) > 0.0)
-                })
+            let bracketed = watches.iter().enumerate().any(|(k, w)| {
+                w.active()
+                    && (1..grid.len())
+                        .any(|p| (margin_at(p - 1, k) > 0.0) != (margin_at(p, k) > 0.0))
             });
             if bracketed && !stepper.prepare_interpolation(sc) {
                 return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
             }
-            for watch in watches.iter_mut().filter(|w| w.active()) {
+            for (k, watch) in watches.iter_mut().enumerate() {
+                if !watch.active() {
+                    continue;
+                }
                 let c = watch.condition;
-                for w in grid.windows(2) {
-                    let (a, b) = (w[0].0, w[1].0);
-                    let (ga, gb) = (c.margin(&w[0].1), c.margin(&w[1].1));
+                for p in 1..grid.len() {
+                    let (a, b) = (grid[p - 1].0, grid[p].0);
+                    let (ga, gb) = (margin_at(p - 1, k), margin_at(p, k));
                     let crossing = |up: bool| {
                         let mut scratch = vec![0.0; n];
                         let margin = |t: f64, y: &[f64]| c.margin(&observe_for_events(t, y));
