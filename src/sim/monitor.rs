@@ -104,14 +104,14 @@ pub(crate) struct Monitor<'a> {
     samples: u64,
     next_k: u64,
     last_sample_t: f64,
-    prev: Observation,
     last_obs: Observation,
-    /// Event-check points of the current step: (time, observation).
-    grid: Vec<(f64, Observation)>,
+    /// Times of the current step's event-check points (its ends and interior points).
+    grid: Vec<f64>,
     /// Each watch's margin at each point of `grid`, point by point (`grid[p]`'s margins at
-    /// `p * watches.len()..`): each margin computed once.
+    /// `p * watches.len()..`): each margin computed once, and no observation kept.
     grid_margins: Vec<f64>,
-    /// Each watch's margin at `prev`, and at the current step's end.
+    /// Each watch's margin at the current step's start (the last step's end, or t = 0), and
+    /// at its end.
     prev_margins: Vec<f64>,
     end_margins: Vec<f64>,
     /// Each condition's margin at the start of the last step, and that step's size (s), for
@@ -203,7 +203,6 @@ impl<'a> Monitor<'a> {
             started,
             sim,
             buf: y0.to_vec(),
-            prev: o0.clone(),
             last_obs: o0.clone(),
             o0,
             inv,
@@ -267,7 +266,6 @@ impl<'a> Monitor<'a> {
             ref mut samples,
             ref mut next_k,
             ref mut last_sample_t,
-            ref mut prev,
             ref mut last_obs,
             ref mut grid,
             ref mut grid_margins,
@@ -407,16 +405,16 @@ impl<'a> Monitor<'a> {
             // Reused across steps: no allocation per step once it has grown.
             grid.clear();
             grid_margins.clear();
-            grid.push((t0, prev.clone()));
+            grid.push(t0);
             grid_margins.extend_from_slice(prev_margins);
             for j in 1..=checks {
                 let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
                 stepper.interpolate(t, buf);
                 let o = observe_for_events(t, buf);
                 grid_margins.extend(watches.iter().map(|w| w.condition.margin(&o)));
-                grid.push((t, o));
+                grid.push(t);
             }
-            grid.push((t1, o1.clone()));
+            grid.push(t1);
             grid_margins.extend_from_slice(end_margins);
             std::mem::swap(prev_margins, end_margins);
             let margin_at = |p: usize, w: usize| grid_margins[p * n_watches + w];
@@ -435,7 +433,7 @@ impl<'a> Monitor<'a> {
                 }
                 let c = watch.condition;
                 for p in 1..grid.len() {
-                    let (a, b) = (grid[p - 1].0, grid[p].0);
+                    let (a, b) = (grid[p - 1], grid[p]);
                     let (ga, gb) = (margin_at(p - 1, k), margin_at(p, k));
                     let crossing = |up: bool| {
                         let mut scratch = vec![0.0; n];
@@ -534,9 +532,6 @@ impl<'a> Monitor<'a> {
                     condition: c.describe(),
                 }));
             }
-        }
-        if let Some(o1) = o1 {
-            *prev = o1;
         }
         Ok(None)
     }
