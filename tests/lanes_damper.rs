@@ -180,7 +180,7 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
         // Per run: grid times handed inside steps, at step ends, and left over.
         let mut counts = vec![(0u64, 0u64, 0u64); runs.len()];
         let mut buf = [0.0; 10];
-        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step| {
+        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step, dense| {
             let sc = &craft[k];
             let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
             assert_observed_as_scalar(sc, step.t, &step.y, &step.end, &what);
@@ -195,7 +195,9 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
             match (&step.sample, inside.first()) {
                 (Some(s), Some(&tk)) => {
                     assert_eq!(s.t.to_bits(), tk.to_bits(), "{what}: sample time");
-                    step.interpolate(tk, &mut buf);
+                    let mut cont = [[0.0; 10]; 5];
+                    dense.coefficients(&mut cont);
+                    step.interpolate(&cont, tk, &mut buf);
                     for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
                         assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
                     }

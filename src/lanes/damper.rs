@@ -111,7 +111,8 @@ pub enum LaneStatus {
 }
 
 /// An accepted step of one lane, as [`integrate_runs_observed`] hands it to its observer: the
-/// step's ends and the coefficients of its dense output (those of the scalar `Dopri5`).
+/// step's ends, its work and its observations (its dense output comes beside it, as a
+/// [`DenseOutput`]).
 #[derive(Debug, Clone, Default)]
 pub struct LaneStep {
     /// Start of the step (s).
@@ -120,8 +121,6 @@ pub struct LaneStep {
     pub t: f64,
     /// State at the end of the step (layout of [`DIM`]).
     pub y: [f64; DIM],
-    /// Dense-output coefficients of the step.
-    pub cont: [[f64; DIM]; 5],
     /// Work so far: accepted and rejected steps, right-hand-side evaluations.
     pub stats: Stats,
     /// The observation at the end of the step (of an observed integration).
@@ -186,11 +185,33 @@ impl<L: Lane> LaneObservation<L> {
     }
 }
 
+/// The dense output of the step a lane has just accepted, still in the lanes: gathered out
+/// of them for that lane only when asked, since the observer rarely interpolates (the lanes
+/// hand it the step's end and its first grid sample already observed).
+pub trait DenseOutput {
+    /// The step's dense-output coefficients (those of the scalar `Dopri5`), into `out`.
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]);
+}
+
+/// Lane `lane`'s dense output in the lanes' coefficients.
+struct LaneDense<'a, L: Lane> {
+    cont: &'a [[L; DIM]; 5],
+    lane: usize,
+}
+
+impl<L: Lane> DenseOutput for LaneDense<'_, L> {
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
+        for (out, cont) in out.iter_mut().zip(self.cont) {
+            L::gather_lane(cont, self.lane, out);
+        }
+    }
+}
+
 impl LaneStep {
-    /// The state at `t` (s) in the step, from its dense output (as the scalar `Dopri5`
-    /// interpolates).
-    pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, &self.y, &self.cont, out);
+    /// The state at `t` (s) in the step, from its dense-output coefficients `cont`
+    /// ([`DenseOutput::coefficients`]), as the scalar `Dopri5` interpolates.
+    pub fn interpolate(&self, cont: &[[f64; DIM]; 5], t: f64, out: &mut [f64]) {
+        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, &self.y, cont, out);
     }
 
     /// The step view of a run's end (`outcome`): its state, with no step to interpolate in.
@@ -218,9 +239,9 @@ pub struct LaneOutcome {
     pub stats: Stats,
 }
 
-/// What [`integrate_runs_observed`] calls after each accepted step of a run: `(run, step)`,
-/// the run's index and its step; false ends the run there.
-pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep) -> bool;
+/// What [`integrate_runs_observed`] calls after each accepted step of a run: `(run, step,
+/// dense)`, the run's index, its step and the step's dense output; false ends the run there.
+pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep, &dyn DenseOutput) -> bool;
 
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -258,7 +279,7 @@ pub fn integrate_runs_with(
 pub fn integrate_runs_observed(
     runs: &[DamperRun],
     settings: &LaneSettings,
-    observe: &mut dyn FnMut(usize, &LaneStep) -> bool,
+    observe: Observer<'_>,
 ) -> Vec<LaneOutcome> {
     run_engine(Engine::Auto, runs, settings, Some(observe))
 }
@@ -268,7 +289,7 @@ pub fn integrate_runs_observed_with(
     engine: Engine,
     runs: &[DamperRun],
     settings: &LaneSettings,
-    observe: &mut dyn FnMut(usize, &LaneStep) -> bool,
+    observe: Observer<'_>,
 ) -> Vec<LaneOutcome> {
     run_engine(engine, runs, settings, Some(observe))
 }
@@ -582,9 +603,6 @@ impl<L: Lane> Lanes<L> {
         step.t_prev = self.t_prev.lane(i);
         step.t = self.t.lane(i);
         L::gather_lane(&self.y, i, &mut step.y);
-        for (out, cont) in step.cont.iter_mut().zip(&self.cont) {
-            L::gather_lane(cont, i, out);
-        }
         if let Some(e) = &self.end {
             step.end = e.lane(i);
         }
@@ -894,7 +912,11 @@ fn lockstep<L: Lane>(
                         && accepted.test(i)
                     {
                         lanes.step_of(i, &mut step);
-                        if !observe(index, &step) {
+                        let dense = LaneDense {
+                            cont: &lanes.cont,
+                            lane: i,
+                        };
+                        if !observe(index, &step, &dense) {
                             lanes.end_observed(i);
                         }
                     }

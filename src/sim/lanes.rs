@@ -13,38 +13,69 @@ use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
-    DIM, DamperRun, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
+    DIM, DamperRun, DenseOutput, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
     integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
+use std::cell::OnceCell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A lane's step as the monitor reads it: the dense output is always there.
-struct LaneView<'s>(&'s LaneStep);
+/// A lane's step as the monitor reads it, with its dense output, gathered out of the lanes
+/// the first time the monitor interpolates in the step.
+struct LaneView<'s> {
+    step: &'s LaneStep,
+    dense: &'s dyn DenseOutput,
+    cont: OnceCell<[[f64; DIM]; 5]>,
+}
+
+impl<'s> LaneView<'s> {
+    fn new(step: &'s LaneStep, dense: &'s dyn DenseOutput) -> Self {
+        LaneView {
+            step,
+            dense,
+            cont: OnceCell::new(),
+        }
+    }
+}
+
+/// The dense output of a run's end, where there is no step to interpolate in (`t_prev = t`:
+/// the interpolation is the state there).
+struct NoStep;
+
+impl DenseOutput for NoStep {
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
+        *out = [[0.0; DIM]; 5];
+    }
+}
 
 impl StepView for LaneView<'_> {
     fn t(&self) -> f64 {
-        self.0.t
+        self.step.t
     }
     fn t_prev(&self) -> f64 {
-        self.0.t_prev
+        self.step.t_prev
     }
     fn y(&self) -> &[f64] {
-        &self.0.y
+        &self.step.y
     }
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        self.0.interpolate(t, out);
+        let cont = self.cont.get_or_init(|| {
+            let mut cont = [[0.0; DIM]; 5];
+            self.dense.coefficients(&mut cont);
+            cont
+        });
+        self.step.interpolate(cont, t, out);
     }
     fn prepare_interpolation(&mut self, _: &Spacecraft) -> bool {
         true
     }
     fn stats(&self) -> Stats {
-        self.0.stats
+        self.step.stats
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
-        let step = self.0;
+        let step = self.step;
         Some(observation(sc, step.t, &step.y, &step.end, angles))
     }
     fn observe_at(
@@ -54,7 +85,7 @@ impl StepView for LaneView<'_> {
         angles: bool,
         out: &mut [f64],
     ) -> Option<Observation> {
-        let sample = self.0.sample.as_ref()?;
+        let sample = self.step.sample.as_ref()?;
         if sample.t.to_bits() != t.to_bits() {
             return None;
         }
@@ -204,7 +235,7 @@ pub fn run_in_lanes<S: Sink + Default>(
                 y: y0,
                 ..LaneStep::default()
             };
-            let outcome = monitor.finish(&LaneView(&start), status, &mut sink)?;
+            let outcome = monitor.finish(&LaneView::new(&start, &NoStep), status, &mut sink)?;
             results[index] = Some((outcome, sink));
             continue;
         }
@@ -220,13 +251,16 @@ pub fn run_in_lanes<S: Sink + Default>(
         return Ok(results);
     };
     let mut io_error = None;
-    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step| {
+    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step, dense| {
         let w = &mut watched[k];
         if interrupt.load(Ordering::Relaxed) {
             w.status = Some(Status::Interrupted);
             return false;
         }
-        match w.monitor.after_step(&mut LaneView(step), &mut w.sink) {
+        match w
+            .monitor
+            .after_step(&mut LaneView::new(step, dense), &mut w.sink)
+        {
             Ok(None) => true,
             Ok(Some(status)) => {
                 w.status = Some(status);
@@ -253,7 +287,9 @@ pub fn run_in_lanes<S: Sink + Default>(
         };
         let mut sink = w.sink;
         let end = LaneStep::at_end(&outcome);
-        let result = w.monitor.finish(&LaneView(&end), status, &mut sink)?;
+        let result = w
+            .monitor
+            .finish(&LaneView::new(&end, &NoStep), status, &mut sink)?;
         results[w.index] = Some((result, sink));
     }
     Ok(results)
