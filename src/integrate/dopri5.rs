@@ -360,8 +360,22 @@ pub(crate) fn dense_value<C: AsRef<[f64]>>(
         out.copy_from_slice(cont[0].as_ref());
         return;
     }
-    let th = (t - t_prev) / h;
-    let th1 = 1.0 - th;
+    dense_interior(t, t_prev, t_now, cont, out);
+}
+
+/// The dense output at `t` (s) strictly inside the accepted step from `t_prev` to `t_now`,
+/// from its coefficients `cont` ([`dense_coefficients`]), into `out`, per lane: what
+/// [`dense_value`] computes away from the step's ends.
+#[inline(always)]
+pub(crate) fn dense_interior<L: Lane, C: AsRef<[L]>>(
+    t: L,
+    t_prev: L,
+    t_now: L,
+    cont: &[C; 5],
+    out: &mut [L],
+) {
+    let th = (t - t_prev) / (t_now - t_prev);
+    let th1 = L::splat(1.0) - th;
     let [c1, c2, c3, c4, c5] = cont;
     let (c1, c2, c3, c4, c5) = (
         c1.as_ref(),

@@ -26,8 +26,8 @@
 use super::{F64x4, Lane, LaneMask, linalg};
 use crate::effectors::spring_mass::{SpringMass, SpringMassLanes};
 use crate::integrate::dopri5::{
-    MAX_REJECTIONS, StageRhs, accepted_step_size, dense_coefficients, error_factor, error_norm,
-    initial_step, kept_proposal, non_finite_step_size, rejected_step_size, stages,
+    MAX_REJECTIONS, StageRhs, accepted_step_size, dense_coefficients, dense_interior, error_factor,
+    error_norm, initial_step, kept_proposal, non_finite_step_size, rejected_step_size, stages,
 };
 use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
@@ -722,17 +722,8 @@ impl<L: Lane> Lanes<L> {
         let t_k = self.next_sample / self.sample_rate;
         let due = gridded & t_k.less_than(self.t);
         self.sample = if due.any() {
-            let h = self.t - self.t_prev;
-            let theta = (t_k - self.t_prev) / h;
-            let theta1 = one - theta;
-            let [c1, c2, c3, c4, c5] = &self.cont;
-            // A loop, not `array::from_fn`, whose closure would be compiled outside the AVX2
-            // build.
             let mut y = [zero; DIM];
-            for j in 0..DIM {
-                y[j] =
-                    c1[j] + theta * (c2[j] + theta1 * (c3[j] + theta * (c4[j] + theta1 * c5[j])));
-            }
+            dense_interior(t_k, self.t_prev, self.t, &self.cont, &mut y);
             Some(SampleLanes {
                 due,
                 t: t_k,
