@@ -18,3 +18,15 @@ pub fn avx2_available() -> bool {
         false
     }
 }
+
+/// Whether this processor has AVX-512F (eight f64 per vector instruction).
+pub fn avx512_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx512f")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}

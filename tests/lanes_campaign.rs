@@ -5,8 +5,12 @@
 //! runs, a step-size bound, dispersions that make some draws invalid, and runs of different
 //! lengths (a lane that finishes takes the next run).
 //!
+//! Every lane engine this processor has (eight AVX-512 lanes, four AVX2 lanes, one lane) is
+//! compared.
+//!
 //!   cargo test --release --test lanes_campaign
 
+use polhode::lanes::damper::{Engine, resolved};
 use polhode::montecarlo::{Integration, Prepared, Row};
 use polhode::scenario::{self, Overrides};
 use std::path::Path;
@@ -40,39 +44,57 @@ fn rows(p: &Prepared, threads: usize) -> Vec<Row> {
     rows
 }
 
-/// Runs `p` in lanes and on the scalar path and compares every row bit for bit; returns the
-/// rows.
+/// The lane engines this processor runs (each resolved: a width it lacks falls back).
+fn engines() -> Vec<Engine> {
+    let mut engines: Vec<Engine> = [Engine::Avx512, Engine::Avx2, Engine::Scalar]
+        .into_iter()
+        .map(resolved)
+        .collect();
+    engines.dedup();
+    engines
+}
+
+/// Runs `p` in lanes with every engine this processor has and on the scalar path, and
+/// compares every row bit for bit; returns the rows of the widest lanes.
 fn assert_same_rows(p: Prepared) -> Vec<Row> {
     assert!(
         matches!(p.integration, Integration::Lanes(_)),
         "expected lanes: {:?}",
         p.integration
     );
-    let lanes = rows(&p, 2);
+    let mut in_lanes = Vec::new();
+    let mut p = p;
+    for engine in engines() {
+        p = p.with_lane_engine(engine);
+        assert_eq!(p.integration, Integration::Lanes(engine));
+        in_lanes.push((engine, rows(&p, 2)));
+    }
     let p = p.with_integration(false);
     assert!(matches!(p.integration, Integration::Scalar(_)));
     let scalar = rows(&p, 1);
-    assert_eq!(lanes.len(), scalar.len());
-    for (a, b) in lanes.iter().zip(&scalar) {
-        assert_eq!(a.run, b.run);
-        assert_eq!(
-            a.status, b.status,
-            "run {}: {} vs {}",
-            a.run, a.message, b.message
-        );
-        assert_eq!(a.message, b.message, "run {}", a.run);
-        for (k, (x, y)) in a.values.iter().zip(&b.values).enumerate() {
+    for (engine, lanes) in &in_lanes {
+        assert_eq!(lanes.len(), scalar.len());
+        for (a, b) in lanes.iter().zip(&scalar) {
+            assert_eq!(a.run, b.run);
             assert_eq!(
-                x.map(f64::to_bits),
-                y.map(f64::to_bits),
-                "run {}, column {} ({}): {x:?} vs {y:?}",
-                a.run,
-                k,
-                p.columns[k]
+                a.status, b.status,
+                "{engine:?}, run {}: {} vs {}",
+                a.run, a.message, b.message
             );
+            assert_eq!(a.message, b.message, "{engine:?}, run {}", a.run);
+            for (k, (x, y)) in a.values.iter().zip(&b.values).enumerate() {
+                assert_eq!(
+                    x.map(f64::to_bits),
+                    y.map(f64::to_bits),
+                    "{engine:?}, run {}, column {} ({}): {x:?} vs {y:?}",
+                    a.run,
+                    k,
+                    p.columns[k]
+                );
+            }
         }
     }
-    lanes
+    in_lanes.swap_remove(0).1
 }
 
 const DISPERSED: &str = "    - {path: \"initial.omega[0]\", normal: {sd: 0.02}}\n    \

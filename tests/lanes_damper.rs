@@ -4,7 +4,8 @@
 //! `spring_mass_damper` effector, whose right-hand side is its nalgebra closed form), stepped to
 //! each run's end time. Each lane must give the same accepted and rejected steps, right-hand-side
 //! evaluations, final time and final state, to the bit, on every engine (one lane, four lanes
-//! compiled for the baseline target, four lanes compiled for AVX2).
+//! compiled for the baseline target, four lanes compiled for AVX2 and eight in AVX-512
+//! registers, where the processor has them).
 //!
 //!   cargo test --release --test lanes_damper
 //!   cargo test --release --test lanes_damper -- --ignored --nocapture   # the runs/s figures
@@ -127,6 +128,9 @@ fn engines() -> Vec<Engine> {
     let mut e = vec![Engine::Scalar, Engine::Portable4];
     if polhode::cpu::avx2_available() {
         e.push(Engine::Avx2);
+    }
+    if polhode::cpu::avx512_available() {
+        e.push(Engine::Avx512);
     }
     e
 }

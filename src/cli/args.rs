@@ -132,6 +132,11 @@ pub(super) enum Command {
         /// form (the rows are the same; for comparison).
         #[arg(long)]
         no_lanes: bool,
+        /// Runs integrated at once per thread where the scene has a lane form: 8 (AVX-512),
+        /// 4 (AVX2) or 1; default the widest this processor has, and a width it lacks falls
+        /// back to the next narrower (the rows are the same; for comparison).
+        #[arg(long, value_name = "W", value_parser = ["1", "4", "8"], conflicts_with = "no_lanes")]
+        lane_width: Option<String>,
         /// Print nothing but errors.
         #[arg(long, short)]
         quiet: bool,

@@ -115,6 +115,7 @@ pub fn main() -> i32 {
             out,
             method,
             no_lanes,
+            lane_width,
             quiet,
         } => montecarlo::montecarlo_cmd(
             &scenario,
@@ -126,6 +127,7 @@ pub fn main() -> i32 {
                 out,
                 method,
                 lanes: !no_lanes,
+                lane_width,
                 quiet,
             },
         ),

@@ -1,6 +1,7 @@
 //! `polhode montecarlo` and `polhode merge`: campaigns, whole or in shards.
 
 use super::{EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_IO};
+use crate::lanes::damper::Engine;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -37,6 +38,8 @@ pub(super) struct Options<'a> {
     pub(super) method: Option<String>,
     /// Lanes where the scene has a lane form (`--no-lanes` clears it).
     pub(super) lanes: bool,
+    /// `--lane-width`: "1", "4" or "8" (checked by the parser); None: the widest.
+    pub(super) lane_width: Option<String>,
     pub(super) quiet: bool,
 }
 
@@ -51,10 +54,17 @@ pub(super) fn montecarlo_cmd(path: &Path, options: Options) -> i32 {
         out,
         method,
         lanes,
+        lane_width,
         quiet,
     } = options;
+    let engine = match lane_width.as_deref() {
+        Some("1") => Engine::Scalar,
+        Some("4") => Engine::Avx2,
+        Some(_) => Engine::Avx512,
+        None => Engine::Auto,
+    };
     let prep = match montecarlo::load_with_method(path, runs, seed, method) {
-        Ok(p) => p.with_integration(lanes),
+        Ok(p) => p.with_lane_engine(engine).with_integration(lanes),
         Err(e) => {
             eprintln!("error: {e}");
             return EXIT_BAD_INPUT;

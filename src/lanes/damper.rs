@@ -15,9 +15,10 @@
 //! scalar `Dopri5` on that run's `Spacecraft`, stepped to the same end time (the tests in
 //! tests/lanes_damper.rs compare them).
 //!
-//! [`integrate_runs`] picks the engine at run time: four f64 lanes compiled for AVX2
-//! where the processor has it ([`Engine::Avx2`], asked through [`crate::cpu`]), otherwise one
-//! lane ([`Engine::Scalar`]).
+//! [`integrate_runs`] picks the engine at run time: eight f64 lanes compiled for AVX-512
+//! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
+//! ([`Engine::Avx2`]), both asked through [`crate::cpu`], otherwise one lane
+//! ([`Engine::Scalar`]).
 //! [`integrate_runs_observed`] also hands each accepted step of each lane, with its dense
 //! output, to an observer that may end the run: the campaigns' run monitor (samples, events,
 //! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
@@ -246,7 +247,8 @@ pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep, &dyn DenseOutput) ->
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Engine {
-    /// AVX2 where the processor has it, else [`Engine::Scalar`].
+    /// The widest the processor has: [`Engine::Avx512`], else [`Engine::Avx2`], else
+    /// [`Engine::Scalar`].
     Auto,
     /// One lane (`f64`): the same lockstep code at width 1.
     Scalar,
@@ -256,6 +258,20 @@ pub enum Engine {
     /// Four lanes compiled for AVX2; falls back to [`Engine::Scalar`] on a processor
     /// without it.
     Avx2,
+    /// Eight lanes in AVX-512 registers (intrinsics, x86-64 only); falls back to [`Engine::Avx2`] (and on to
+    /// [`Engine::Scalar`]) on a processor without it.
+    Avx512,
+}
+
+impl Engine {
+    /// Runs integrated at once on one thread.
+    pub fn width(self) -> usize {
+        match resolved(self) {
+            Engine::Portable4 | Engine::Avx2 => 4,
+            Engine::Avx512 => 8,
+            _ => 1,
+        }
+    }
 }
 
 /// Integrates every run to its end time with the engine chosen at run time
@@ -296,9 +312,11 @@ pub fn integrate_runs_observed_with(
 
 /// The engine actually run for `engine` on this processor.
 pub fn resolved(engine: Engine) -> Engine {
+    use crate::cpu::{avx2_available, avx512_available};
     match engine {
-        Engine::Auto | Engine::Avx2 if crate::cpu::avx2_available() => Engine::Avx2,
-        Engine::Auto | Engine::Avx2 => Engine::Scalar,
+        Engine::Auto | Engine::Avx512 if avx512_available() => Engine::Avx512,
+        Engine::Auto | Engine::Avx512 | Engine::Avx2 if avx2_available() => Engine::Avx2,
+        Engine::Auto | Engine::Avx512 | Engine::Avx2 => Engine::Scalar,
         e => e,
     }
 }
@@ -316,6 +334,11 @@ fn run_engine(
             // SAFETY: `resolved` chose AVX2 only where the processor has it.
             unsafe { lockstep_avx2(runs, settings, observe) }
         }
+        #[cfg(target_arch = "x86_64")]
+        Engine::Avx512 => {
+            // SAFETY: `resolved` chose AVX-512F only where the processor has it.
+            unsafe { lockstep_avx512(runs, settings, observe) }
+        }
         _ => lockstep::<f64>(runs, settings, observe),
     }
 }
@@ -331,6 +354,19 @@ unsafe fn lockstep_avx2(
     observe: Option<Observer<'_>>,
 ) -> Vec<LaneOutcome> {
     lockstep::<F64x4>(runs, settings, observe)
+}
+
+/// [`lockstep`] at eight lanes, compiled for AVX-512F so that the lane type's intrinsics
+/// inline into it: one 512-bit instruction per element-wise operation. Nothing is fused (no
+/// fused intrinsic is called, and Rust contracts nothing): the bits are the scalar path's.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn lockstep_avx512(
+    runs: &[DamperRun],
+    settings: &LaneSettings,
+    observe: Option<Observer<'_>>,
+) -> Vec<LaneOutcome> {
+    lockstep::<super::f64x8::F64x8>(runs, settings, observe)
 }
 
 /// The parameters of the runs in the lanes.
@@ -383,19 +419,19 @@ impl<L: Lane> System<L> {
         let attitude = [qw / q_norm, qi / q_norm, qj / q_norm, qk / q_norm];
         let i = &self.hub_inertia;
         // hub_inertia[c][r] is I(r, c).
-        let iw: [L; 3] = std::array::from_fn(|r| i[0][r] * w[0] + i[1][r] * w[1] + i[2][r] * w[2]);
+        let iw: [L; 3] = linalg::each3(|r| i[0][r] * w[0] + i[1][r] * w[1] + i[2][r] * w[2]);
         let mut h = iw;
         let mut kinetic = half * (w[0] * iw[0] + w[1] * iw[1] + w[2] * iw[2]);
         let d = &self.damper;
         let (q, u) = (y[7], y[8]);
         let m = d.mass;
-        let r: [L; 3] = std::array::from_fn(|k| d.position[k] + q * d.direction[k]);
+        let r: [L; 3] = linalg::each3(|k| d.position[k] + q * d.direction[k]);
         let wr = cross(w, r);
-        let v: [L; 3] = std::array::from_fn(|k| wr[k] + u * d.direction[k]);
+        let v: [L; 3] = linalg::each3(|k| wr[k] + u * d.direction[k]);
         let rv = cross(r, v);
         let mass = self.hub_mass + m;
-        let first_moment: [L; 3] = std::array::from_fn(|k| zero + m * r[k]);
-        let linear: [L; 3] = std::array::from_fn(|k| zero + m * v[k]);
+        let first_moment: [L; 3] = linalg::each3(|k| zero + m * r[k]);
+        let linear: [L; 3] = linalg::each3(|k| zero + m * v[k]);
         for k in 0..3 {
             h[k] += m * rv[k];
         }
@@ -403,7 +439,7 @@ impl<L: Lane> System<L> {
         // The hub moves at −P/M when the particles carry linear momentum.
         let moving = mass.greater_than(zero)
             & !(linear[0].equals(zero) & linear[1].equals(zero) & linear[2].equals(zero));
-        let v_hub: [L; 3] = std::array::from_fn(|k| -linear[k] / mass);
+        let v_hub: [L; 3] = linalg::each3(|k| -linear[k] / mass);
         let c = cross(first_moment, v_hub);
         for k in 0..3 {
             h[k] = L::select(moving, h[k] + c[k], h[k]);
@@ -415,7 +451,7 @@ impl<L: Lane> System<L> {
         let t = cross(axis, h);
         let t = [t[0] * two, t[1] * two, t[2] * two];
         let ut = cross(axis, t);
-        let h_inertial: [L; 3] = std::array::from_fn(|k| t[k] * attitude[0] + ut[k] + h[k]);
+        let h_inertial: [L; 3] = linalg::each3(|k| t[k] * attitude[0] + ut[k] + h[k]);
         LaneObservation {
             attitude,
             q_norm_error: q_norm - L::splat(1.0),

@@ -90,6 +90,14 @@ pub fn quaternion_rate<L: Lane>(q: [L; 4], omega: [L; 3]) -> [L; 4] {
     ]
 }
 
+/// `[f(0), f(1), f(2)]`, written out: `std::array::from_fn` may leave its closure out of line,
+/// and an out-of-line function does not get the instruction set of the engine it is called
+/// from (the eight AVX-512 lanes' intrinsics then become calls).
+#[inline(always)]
+pub fn each3<L: Lane>(f: impl Fn(usize) -> L) -> [L; 3] {
+    [f(0), f(1), f(2)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

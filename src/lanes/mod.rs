@@ -1,5 +1,5 @@
 //! Lanes: the same arithmetic on one number (`f64`) or on several independent runs at once
-//! ([`F64x4`], four f64 lanes).
+//! ([`F64x4`], four f64 lanes; eight on AVX-512).
 //!
 //! A [`Lane`] is a value of one run (`f64`, width 1) or of W runs side by side, one per lane.
 //! Every operation acts lane by lane with the rounding of the f64 operation it names (IEEE 754
@@ -12,15 +12,20 @@
 //! The right-hand sides and the stepper arithmetic that the ensemble integrators share with
 //! the scalar path are written once, generic over `Lane`: at `f64` they are the code the
 //! scalar path runs (the spring–mass damper's closed form, the hub's quaternion kinematics,
-//! dopri5's stages, error norm and step-size control), at `F64x4` the code of the lanes.
+//! dopri5's stages, error norm and step-size control), at `F64x4` (and the eight-lane AVX-512
+//! type) the code of the lanes.
 //!
-//! Layout: [`f64x4`] (the 4-wide lane and its mask), [`linalg`] (3-vectors, 3 × 3 products,
-//! the SPD inverse and the quaternion rate, in lanes), [`damper`] (the lockstep dopri5
-//! ensemble of the nutation-damper class, with the AVX2 dispatch). docs/montecarlo.md,
+//! Layout: [`f64x4`] (four lanes as a plain array, and its mask), `f64x8` (eight lanes in an
+//! AVX-512 register, x86-64 only, crate-private), [`linalg`] (3-vectors,
+//! 3 × 3 products, the SPD inverse and the quaternion rate, in lanes), [`damper`] (the
+//! lockstep dopri5 ensemble of the nutation-damper class, with the AVX2 and AVX-512
+//! dispatch). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;
 pub mod f64x4;
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod f64x8;
 pub mod linalg;
 
 pub use f64x4::{F64x4, M64x4};

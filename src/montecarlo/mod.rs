@@ -125,6 +125,8 @@ pub struct Prepared {
     pub integration: Integration,
     /// Whether lanes are wanted where the scene has a lane form (`--no-lanes` clears it).
     lanes_wanted: bool,
+    /// The lane engine asked for (`--lane-width`; default the widest this processor has).
+    lane_engine: Engine,
 }
 
 /// How a campaign's runs are integrated on each thread.
@@ -139,10 +141,11 @@ pub enum Integration {
 }
 
 impl Integration {
-    /// How the runs of `scenario` are integrated on this processor.
-    pub fn of(scenario: &Scenario) -> Self {
+    /// How the runs of `scenario` are integrated on this processor, in lanes with `engine`
+    /// (or the nearest it has) where the scene has a lane form.
+    pub fn of(scenario: &Scenario, engine: Engine) -> Self {
         match sim::lane_form(scenario) {
-            Ok(_) => Integration::Lanes(crate::lanes::damper::resolved(Engine::Auto)),
+            Ok(_) => Integration::Lanes(crate::lanes::damper::resolved(engine)),
             Err(why) => Integration::Scalar(format!("the scene has no lane form: {why}")),
         }
     }
@@ -150,6 +153,9 @@ impl Integration {
     /// A line for the campaign's header: where the runs go and why.
     pub fn describe(&self) -> String {
         match self {
+            Integration::Lanes(Engine::Avx512) => {
+                "in lockstep lanes, eight runs at once per thread (AVX-512)".into()
+            }
             Integration::Lanes(Engine::Avx2) => {
                 "in lockstep lanes, four runs at once per thread (AVX2)".into()
             }
@@ -445,6 +451,7 @@ impl Prepared {
             redraw_columns,
             integration: Integration::Scalar(String::new()),
             lanes_wanted: true,
+            lane_engine: Engine::Auto,
         }
         .with_integration(true))
     }
@@ -454,11 +461,19 @@ impl Prepared {
     pub fn with_integration(mut self, lanes: bool) -> Self {
         self.lanes_wanted = lanes;
         self.integration = if lanes {
-            Integration::of(&self.scenario)
+            Integration::of(&self.scenario, self.lane_engine)
         } else {
             Integration::Scalar("--no-lanes".into())
         };
         self
+    }
+
+    /// Lanes with `engine` (or the nearest this processor has) instead of the widest
+    /// (`--lane-width`; the rows are the same).
+    pub fn with_lane_engine(mut self, engine: Engine) -> Self {
+        self.lane_engine = engine;
+        let lanes = self.lanes_wanted;
+        self.with_integration(lanes)
     }
 
     /// The random stream of run `i`: ChaCha8 seeded with the campaign seed, stream `i`.
@@ -781,7 +796,11 @@ impl Prepared {
             let slots: Vec<Mutex<Option<Row>>> = (0..n).map(|_| Mutex::new(None)).collect();
             // Lanes take a chunk of runs at a time: enough to keep the lanes full (a lane that
             // finishes takes the chunk's next run), few enough to share the block out.
-            let chunk = (n / (4 * threads.max(1))).clamp(8, 128);
+            let width = match self.integration {
+                Integration::Lanes(engine) => engine.width(),
+                Integration::Scalar(_) => 1,
+            };
+            let chunk = (n / (4 * threads.max(1))).clamp(2 * width.max(4), 128);
             pool.broadcast(|_| {
                 while let Integration::Lanes(engine) = self.integration {
                     let k = next.fetch_add(chunk, Ordering::Relaxed);
