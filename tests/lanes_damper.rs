@@ -1,4 +1,5 @@
-//! The lockstep lanes of the nutation-damper class against the scalar path, bit for bit.
+//! The lockstep lanes of the nutation-damper class against the scalar path, bit for bit (states,
+//! work, observations, grid samples and drift terms).
 //!
 //! The reference is the scalar `Dopri5` on a `Spacecraft` built the normal way (a hub with a
 //! `spring_mass_damper` effector, whose right-hand side is its nalgebra closed form), stepped to
@@ -19,6 +20,7 @@ use polhode::lanes::damper::{
     integrate_runs_observed_with, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
+use polhode::sim::Reference;
 use std::time::Instant;
 
 /// The scenario's tolerances (scenarios/nutation-damper.yaml).
@@ -180,6 +182,12 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
         run.sample_rate = rate;
     }
     let craft: Vec<Spacecraft> = runs.iter().map(spacecraft).collect();
+    // What the run monitor measures each run's drift against.
+    let references: Vec<Reference> = runs
+        .iter()
+        .zip(&craft)
+        .map(|(run, sc)| Reference::of(&sc.observe(0.0, &run.initial_state())))
+        .collect();
     for engine in engines() {
         // Per run: grid times handed inside steps, at step ends, and left over.
         let mut counts = vec![(0u64, 0u64, 0u64); runs.len()];
@@ -188,6 +196,20 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
             let sc = &craft[k];
             let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
             assert_observed_as_scalar(sc, step.t, &step.y, &step.end, &what);
+            // The drift terms, as the monitor computes them from the scalar observation.
+            let terms = references[k].terms(&sc.observe(step.t, &step.y).invariants());
+            for (name, a, b) in [
+                ("|H|", step.drift.h_norm_rel, terms.h_norm_rel),
+                ("H_N", step.drift.h_inertial_rel, terms.h_inertial_rel),
+                ("energy", step.drift.energy_rel, terms.energy_rel),
+                ("|q|", step.drift.q_norm, terms.q_norm),
+            ] {
+                assert_eq!(
+                    a.to_bits(),
+                    b.to_bits(),
+                    "{what}: {name} drift {a:e} vs {b:e}"
+                );
+            }
             // The grid times in (t_prev, t].
             let first = (step.t_prev * rate).floor() as u64 + 1;
             let grid: Vec<f64> = (first..)

@@ -126,6 +126,8 @@ pub struct LaneStep {
     pub stats: Stats,
     /// The observation at the end of the step (of an observed integration).
     pub end: LaneObservation,
+    /// The run's drift at the end of the step from its start (of an observed integration).
+    pub drift: LaneDrift,
     /// The first time of the run's output grid strictly inside the step, if there is one, with
     /// the state there and its observation (of an observed integration).
     pub sample: Option<LaneSample>,
@@ -183,6 +185,99 @@ impl<L: Lane> LaneObservation<L> {
         L::gather_lane(&self.h_body, i, &mut o.h_body);
         L::gather_lane(&self.h_inertial, i, &mut o.h_inertial);
         o
+    }
+}
+
+/// A run's drift at a state from its start (t = 0), computed in the lanes with the operations
+/// (and their order) of the run monitor's drift check (`sim::Reference`), so that each term is
+/// bit for bit the scalar path's: |H₀| is the body-frame |H| at t = 0 (nalgebra's norm,
+/// `√(0 + ((x² + y²) + z²))`), E is kinetic + elastic + dissipated energy, and this class
+/// carries no momentum out and has no external work (the scalar sums add their zeros). `T` is
+/// one value ([`f64`]) or one per lane.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LaneDrift<T = f64> {
+    /// |(|H_N| − |H₀|)| / |H₀| (|H₀| = 0: not divided).
+    pub h_norm_rel: T,
+    /// |H_N − H_N₀| / |H₀|.
+    pub h_inertial_rel: T,
+    /// |E − E₀| / E₀ (E₀ = 0: not divided).
+    pub energy_rel: T,
+    /// ||q| − 1|.
+    pub q_norm: T,
+}
+
+impl<L: Lane> LaneDrift<L> {
+    /// Lane `i`'s terms.
+    #[inline(always)]
+    fn lane(&self, i: usize) -> LaneDrift {
+        LaneDrift {
+            h_norm_rel: self.h_norm_rel.lane(i),
+            h_inertial_rel: self.h_inertial_rel.lane(i),
+            energy_rel: self.energy_rel.lane(i),
+            q_norm: self.q_norm.lane(i),
+        }
+    }
+}
+
+/// What the drift is measured against, per lane: the observation at t = 0.
+#[derive(Debug, Clone, Copy)]
+struct DriftReference<L: Lane> {
+    /// |H| at t = 0, body axes (N m s).
+    h0: L,
+    /// H at t = 0, inertial axes (N m s).
+    h_inertial0: [L; 3],
+    /// The energy balance at t = 0 (J).
+    e0: L,
+}
+
+/// `√(0 + ((x² + y²) + z²))`: nalgebra's `Vector3::norm`, per lane.
+#[inline(always)]
+fn norm<L: Lane>(v: [L; 3]) -> L {
+    (L::splat(0.0) + linalg::dot(v, v)).sqrt()
+}
+
+/// `d / reference`, or `d` where the reference is zero (the monitor's `rel`).
+#[inline(always)]
+fn relative<L: Lane>(d: L, reference: L) -> L {
+    L::select(!reference.equals(L::splat(0.0)), d / reference, d)
+}
+
+impl<L: Lane> LaneObservation<L> {
+    /// The energy balance, kinetic + elastic + dissipated − external work (none here), in
+    /// the order of `Invariants::energy_balance`.
+    #[inline(always)]
+    fn energy_balance(&self) -> L {
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - L::splat(0.0)
+    }
+
+    /// H_N plus the (zero) momentum carried out, as the monitor audits it.
+    #[inline(always)]
+    fn h_audited(&self) -> [L; 3] {
+        let zero = L::splat(0.0);
+        linalg::each3(|k| self.h_inertial[k] + zero)
+    }
+
+    /// What the drift of later states is measured against, this being the state at t = 0.
+    #[inline(always)]
+    fn drift_reference(&self) -> DriftReference<L> {
+        DriftReference {
+            h0: norm(self.h_body),
+            h_inertial0: self.h_inertial,
+            e0: self.energy_balance(),
+        }
+    }
+
+    /// The drift at this state from `reference`, as the monitor's check computes it.
+    #[inline(always)]
+    fn drift(&self, reference: &DriftReference<L>) -> LaneDrift<L> {
+        let r = reference;
+        let h = self.h_audited();
+        LaneDrift {
+            h_norm_rel: relative(norm(h) - r.h0, r.h0).abs(),
+            h_inertial_rel: relative(norm(linalg::each3(|k| h[k] - r.h_inertial0[k])), r.h0),
+            energy_rel: relative(self.energy_balance() - r.e0, r.e0).abs(),
+            q_norm: self.q_norm_error.abs(),
+        }
     }
 }
 
@@ -507,8 +602,12 @@ struct Lanes<L: Lane> {
     k: [[L; DIM]; 7],
     /// Dense-output coefficients of the last accepted step, when observed.
     cont: [[L; DIM]; 5],
-    /// The observation at the end of the last accepted step, when observed.
+    /// The observation at the end of the last accepted step, when observed, and the drift
+    /// there from each run's start.
     end: Option<LaneObservation<L>>,
+    drift: Option<LaneDrift<L>>,
+    /// What each run's drift is measured against (its observation at t = 0), when observed.
+    reference: Option<DriftReference<L>>,
     /// Each run's output grid (Hz; 0: none) and the index k of its next grid time
     /// k / rate after the last accepted step's end, when observed.
     sample_rate: L,
@@ -560,6 +659,8 @@ impl<L: Lane> Lanes<L> {
             k: [[z; DIM]; 7],
             cont: [[z; DIM]; 5],
             end: None,
+            drift: None,
+            reference: None,
             sample_rate: z,
             next_sample: z,
             sample: None,
@@ -642,6 +743,9 @@ impl<L: Lane> Lanes<L> {
         if let Some(e) = &self.end {
             step.end = e.lane(i);
         }
+        if let Some(d) = &self.drift {
+            step.drift = d.lane(i);
+        }
         step.sample = match &self.sample {
             Some(SampleLanes {
                 due,
@@ -692,6 +796,23 @@ impl<L: Lane> Lanes<L> {
                 self.running = self.running.with_lane(i, false);
             }
         }
+    }
+
+    /// The drift reference of the lanes of `starting`, from their state at t = 0 (the run
+    /// monitor's `Reference::of` its first observation).
+    #[inline(always)]
+    fn take_references(&mut self, starting: L::Mask) {
+        let now = self.system.observe(&self.y).drift_reference();
+        self.reference = Some(match self.reference {
+            None => now,
+            Some(was) => DriftReference {
+                h0: L::select(starting, now.h0, was.h0),
+                h_inertial0: linalg::each3(|k| {
+                    L::select(starting, now.h_inertial0[k], was.h_inertial0[k])
+                }),
+                e0: L::select(starting, now.e0, was.e0),
+            },
+        });
     }
 
     /// The first stage and the initial step of the lanes of `starting`, as the scalar
@@ -851,7 +972,9 @@ impl<L: Lane> Lanes<L> {
         }
         self.t = L::select(accept, end.t_new, self.t);
         if observed && accept.any() {
-            self.end = Some(self.system.observe(&self.y));
+            let end = self.system.observe(&self.y);
+            self.drift = self.reference.as_ref().map(|r| end.drift(r));
+            self.end = Some(end);
             self.sample_inside(accept);
         }
         self.steps += L::select(accept, one, zero);
@@ -929,6 +1052,9 @@ fn lockstep<L: Lane>(
             break;
         }
         if starting.any() {
+            if observe.is_some() {
+                lanes.take_references(starting);
+            }
             lanes.start(starting);
         }
         if lanes.running.any() {

@@ -8,7 +8,7 @@
 //! has none; such a run, or one the lanes decline part-way, takes the scalar path.
 
 use super::monitor::{Monitor, StepView};
-use super::{Method, Outcome, Simulation, Sink, Status, diagnose, interior_checks};
+use super::{Drift, Method, Outcome, Simulation, Sink, Status, diagnose, interior_checks};
 use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
@@ -73,6 +73,15 @@ impl StepView for LaneView<'_> {
     }
     fn stats(&self) -> Stats {
         self.step.stats
+    }
+    fn end_drift(&self) -> Option<Drift> {
+        let d = &self.step.drift;
+        Some(Drift {
+            h_norm_rel: d.h_norm_rel,
+            h_inertial_rel: d.h_inertial_rel,
+            energy_rel: d.energy_rel,
+            q_norm: d.q_norm,
+        })
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
         let step = self.step;

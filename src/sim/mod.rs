@@ -159,19 +159,32 @@ impl Reference {
         rel(o.energy_balance() - self.e0, self.e0)
     }
 
-    fn update(&self, d: &mut Drift, i: &Invariants) {
+    /// The drift at one state with invariants `i`: each field of [`Drift`] at that state
+    /// alone (the lanes compute the same terms, with the same operations:
+    /// `lanes::damper::LaneDrift`).
+    pub fn terms(&self, i: &Invariants) -> Drift {
         // With a thruster, H plus what the exhaust carried out is the conserved quantity (the
         // carried part is zero otherwise).
         let h_audited = i.h_inertial + i.h_carried_out;
-        let h = rel(h_audited.norm() - self.h0, self.h0);
-        d.h_norm_rel = d.h_norm_rel.max(h.abs());
-        let e = rel(i.energy_balance() - self.e0, self.e0);
-        d.energy_rel = d.energy_rel.max(e.abs());
-        d.h_inertial_rel = d.h_inertial_rel.max(rel(
-            (i.h_inertial + i.h_carried_out - self.h_inertial0).norm(),
-            self.h0,
-        ));
-        d.q_norm = d.q_norm.max(i.q_norm_error.abs());
+        Drift {
+            h_norm_rel: rel(h_audited.norm() - self.h0, self.h0).abs(),
+            h_inertial_rel: rel(
+                (i.h_inertial + i.h_carried_out - self.h_inertial0).norm(),
+                self.h0,
+            ),
+            energy_rel: rel(i.energy_balance() - self.e0, self.e0).abs(),
+            q_norm: i.q_norm_error.abs(),
+        }
+    }
+}
+
+impl Drift {
+    /// Takes in one state's terms ([`Reference::terms`]): each field keeps its largest.
+    fn absorb(&mut self, terms: &Drift) {
+        self.h_norm_rel = self.h_norm_rel.max(terms.h_norm_rel);
+        self.energy_rel = self.energy_rel.max(terms.energy_rel);
+        self.h_inertial_rel = self.h_inertial_rel.max(terms.h_inertial_rel);
+        self.q_norm = self.q_norm.max(terms.q_norm);
     }
 }
 

@@ -34,6 +34,11 @@ pub(crate) trait StepView {
     fn end_observation(&self, _sc: &Spacecraft, _angles: bool) -> Option<Observation> {
         None
     }
+    /// The drift at the end of the step from the run's start, if the integrator computed it
+    /// already (as `Reference::terms` of the end state's invariants would, bit for bit).
+    fn end_drift(&self) -> Option<Drift> {
+        None
+    }
     /// The state at `t` inside the step into `out` and its observation, if the integrator
     /// made them already (as `interpolate(t, out)` and then
     /// `Spacecraft::observe_for_events(t, out, angles)` would, bit for bit).
@@ -312,11 +317,12 @@ impl<'a> Monitor<'a> {
                     .unwrap_or_else(|| observe_for_events(t1, stepper.y())),
             )
         };
-        let step_invariants = match &o1 {
-            Some(o) => o.invariants(),
-            None => sc.invariants(t1, stepper.y()),
+        let terms = match (stepper.end_drift(), &o1) {
+            (Some(terms), _) => terms,
+            (None, Some(o)) => inv.terms(&o.invariants()),
+            (None, None) => inv.terms(&sc.invariants(t1, stepper.y())),
         };
-        inv.update(drift, &step_invariants);
+        drift.absorb(&terms);
         if passive && drift.energy_rel > DIVERGENCE_ENERGY_REL {
             let what = format!(
                 "the energy balance (kinetic + elastic + dissipated) changed by {:.0}% by \
