@@ -19,7 +19,7 @@ use polhode::lanes::damper::{
     DamperRun, Engine, LaneObservation, LaneOutcome, LaneSettings, LaneStatus, integrate_runs,
     integrate_runs_observed_with, integrate_runs_with,
 };
-use polhode::model::{RigidBody, Spacecraft};
+use polhode::model::{RigidBody, Spacecraft, angle_from};
 use polhode::sim::Reference;
 use std::time::Instant;
 
@@ -82,6 +82,8 @@ fn dispersed_runs(count: usize, seed: u64, t_end: impl Fn(usize) -> f64) -> Vec<
             ),
             offset0: d.uniform(-0.05, 0.05),
             rate0: d.uniform(-0.02, 0.02),
+            // Tilted from z, so that every component of the axis is read.
+            spin_axis: Vector3::new(d.uniform(-0.1, 0.1), d.uniform(-0.1, 0.1), 1.0).normalize(),
             t_end: t_end(i),
             sample_rate: 0.0,
         })
@@ -90,7 +92,10 @@ fn dispersed_runs(count: usize, seed: u64, t_end: impl Fn(usize) -> f64) -> Vec<
 
 /// The run's spacecraft, built as the scenario loader builds it.
 fn spacecraft(run: &DamperRun) -> Spacecraft {
-    let mut sc = Spacecraft::new(RigidBody::new(run.hub_inertia).unwrap(), Vector3::z());
+    let mut sc = Spacecraft::new(RigidBody::new(run.hub_inertia).unwrap(), run.spin_axis);
+    // The run holds the spacecraft's axis as `lane_form` copies it, already unit: normalising
+    // it again could move it by a unit in the last place.
+    sc.spin_axis = run.spin_axis;
     sc.hub_mass = Some(run.hub_mass);
     let damper = ParticleEffector::new("damper", run.damper.clone(), &[run.offset0], &[run.rate0]);
     sc.add_effector(Box::new(damper)).unwrap();
@@ -163,6 +168,12 @@ fn assert_observed_as_scalar(
         ("elastic", lane.elastic_energy, o.elastic_energy),
         ("dissipated", lane.dissipated_energy, o.dissipated_energy),
         ("power", lane.dissipation_power, o.dissipation_power),
+        ("|H|", lane.h_norm, o.h_norm),
+        (
+            "nutation angle",
+            angle_from(lane.nutation_sine, lane.nutation_cosine),
+            o.nutation_angle,
+        ),
     ];
     for (name, a, b) in pairs {
         assert_eq!(a.to_bits(), b.to_bits(), "{what}, {name}: {a} vs {b}");

@@ -54,6 +54,9 @@ pub struct DamperRun {
     pub offset0: f64,
     /// Initial offset rate ρ̇₀ (m/s).
     pub rate0: f64,
+    /// The scene's spin axis (body axes, unit: `Spacecraft::spin_axis`), which the nutation
+    /// angle is measured from.
+    pub spin_axis: Vector3<f64>,
     /// End time (s); the run starts at t = 0.
     pub t_end: f64,
     /// Rate of the output grid k / `sample_rate` (Hz) on which an observed integration also
@@ -167,6 +170,13 @@ pub struct LaneObservation<T = f64> {
     pub dissipated_energy: T,
     /// The dashpot's dissipation rate (W).
     pub dissipation_power: T,
+    /// |H| (N m s), nalgebra's norm of `h_body`.
+    pub h_norm: T,
+    /// |a × H| and a · H, a the spin axis (N m s): the nutation angle is
+    /// `nutation_sine.atan2(nutation_cosine)`, as `observe::angle_between` forms it.
+    pub nutation_sine: T,
+    /// See [`LaneObservation::nutation_sine`].
+    pub nutation_cosine: T,
 }
 
 impl<L: Lane> LaneObservation<L> {
@@ -179,6 +189,9 @@ impl<L: Lane> LaneObservation<L> {
             elastic_energy: self.elastic_energy.lane(i),
             dissipated_energy: self.dissipated_energy.lane(i),
             dissipation_power: self.dissipation_power.lane(i),
+            h_norm: self.h_norm.lane(i),
+            nutation_sine: self.nutation_sine.lane(i),
+            nutation_cosine: self.nutation_cosine.lane(i),
             ..LaneObservation::default()
         };
         L::gather_lane(&self.attitude, i, &mut o.attitude);
@@ -467,6 +480,8 @@ unsafe fn lockstep_avx512(
 /// The parameters of the runs in the lanes.
 struct System<L: Lane> {
     damper: SpringMassLanes<L>,
+    /// The spin axis (body axes, unit).
+    spin_axis: [L; 3],
     hub_inertia: [[L; 3]; 3],
     hub_mass: L,
 }
@@ -502,7 +517,9 @@ impl<L: Lane> System<L> {
     /// `observe::invariants` on a hub with this one damper: nalgebra's `I ω`, dot products
     /// `(x + y) + z`, its 4-vector norm `(i² + k²) + (j² + w²)` and its rotation
     /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
-    /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0).
+    /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0). Then
+    /// `Observation::from_invariants`'s |H| and the nutation angle's two arguments (its
+    /// arctangent stays per lane: the platform's `atan2`).
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
         use linalg::cross;
@@ -547,6 +564,7 @@ impl<L: Lane> System<L> {
         let t = [t[0] * two, t[1] * two, t[2] * two];
         let ut = cross(axis, t);
         let h_inertial: [L; 3] = linalg::each3(|k| t[k] * attitude[0] + ut[k] + h[k]);
+        let a = self.spin_axis;
         LaneObservation {
             attitude,
             q_norm_error: q_norm - L::splat(1.0),
@@ -556,6 +574,9 @@ impl<L: Lane> System<L> {
             elastic_energy: zero + half * d.stiffness * q * q,
             dissipated_energy: zero + y[9],
             dissipation_power: zero + d.damping * u * u,
+            h_norm: norm(h),
+            nutation_sine: norm(cross(a, h)),
+            nutation_cosine: linalg::dot(a, h),
         }
     }
 }
@@ -642,6 +663,7 @@ impl<L: Lane> Lanes<L> {
                     stiffness: z,
                     damping: z,
                 },
+                spin_axis: [z; 3],
                 hub_inertia: [[z; 3]; 3],
                 hub_mass: z,
             },
@@ -690,6 +712,7 @@ impl<L: Lane> Lanes<L> {
         for j in 0..3 {
             set(&mut d.position[j], run.damper.position[j]);
             set(&mut d.direction[j], run.damper.direction[j]);
+            set(&mut self.system.spin_axis[j], run.spin_axis[j]);
             for c in 0..3 {
                 set(&mut self.system.hub_inertia[c][j], run.hub_inertia[(j, c)]);
             }

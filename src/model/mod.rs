@@ -22,7 +22,7 @@ mod observe;
 mod secular;
 
 pub use body::{InertiaError, RigidBody};
-pub use observe::{Invariants, Observation, angle_between};
+pub use observe::{Invariants, Observation, angle_between, angle_from};
 pub use secular::{Forcing, Secular, SecularMotion, SecularRates};
 
 use crate::integrate::OdeSystem;

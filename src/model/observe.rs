@@ -68,7 +68,13 @@ impl Observation {
 
 /// Angle between two vectors (rad), accurate for small and near-π angles alike.
 pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
+    angle_from(a.cross(b).norm(), a.dot(b))
+}
+
+/// The angle between two vectors a and b (rad) from |a × b| and a · b, as [`angle_between`]
+/// forms it.
+pub fn angle_from(cross_norm: f64, dot: f64) -> f64 {
+    cross_norm.atan2(dot)
 }
 
 /// The conserved quantities only: what drift tracking needs at every step.
@@ -189,6 +195,25 @@ impl Observation {
         attitude: UnitQuaternion<f64>,
         angles: bool,
     ) -> Observation {
+        let h_norm = inv.h_body.norm();
+        let nutation_angle = angle_between(&sc.spin_axis, &inv.h_body);
+        Observation::from_parts(sc, t, y, inv, attitude, angles, h_norm, nutation_angle)
+    }
+
+    /// [`Observation::from_invariants`] with |H| (`h_body`'s norm) and the nutation angle
+    /// (`angle_between` the spin axis and `h_body`) already computed, as the lanes compute
+    /// them.
+    #[allow(clippy::too_many_arguments)] // the parts of one observation
+    pub(crate) fn from_parts(
+        sc: &Spacecraft,
+        t: f64,
+        y: &[f64],
+        inv: &Invariants,
+        attitude: UnitQuaternion<f64>,
+        angles: bool,
+        h_norm: f64,
+        nutation_angle: f64,
+    ) -> Observation {
         let omega = Vector3::new(y[0], y[1], y[2]);
         let angles_to_principal = if angles {
             angles_to_principal(sc, &omega)
@@ -202,14 +227,14 @@ impl Observation {
             q_norm_error: inv.q_norm_error,
             h_body: inv.h_body,
             h_inertial: inv.h_inertial,
-            h_norm: inv.h_body.norm(),
+            h_norm,
             h_carried_out: inv.h_carried_out,
             kinetic_energy: inv.kinetic_energy,
             elastic_energy: inv.elastic_energy,
             dissipated_energy: inv.dissipated_energy,
             dissipation_power: inv.dissipation_power,
             external_work: inv.external_work,
-            nutation_angle: angle_between(&sc.spin_axis, &inv.h_body),
+            nutation_angle,
             angles_to_principal,
             field_angle: field_angle(sc, t, y),
         }

@@ -16,7 +16,7 @@ use crate::lanes::damper::{
     DIM, DamperRun, DenseOutput, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
     integrate_runs_observed_with,
 };
-use crate::model::{Invariants, Observation, Spacecraft};
+use crate::model::{Invariants, Observation, Spacecraft, angle_from};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
 use std::cell::OnceCell;
@@ -127,7 +127,17 @@ fn observation(
         q_norm_error: lane.q_norm_error,
     };
     let attitude = UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k));
-    Observation::from_invariants(sc, t, y, &invariants, attitude, angles)
+    let nutation_angle = angle_from(lane.nutation_sine, lane.nutation_cosine);
+    Observation::from_parts(
+        sc,
+        t,
+        y,
+        &invariants,
+        attitude,
+        angles,
+        lane.h_norm,
+        nutation_angle,
+    )
 }
 
 /// `sim` as a run of the lanes' nutation-damper class and the integration settings it needs,
@@ -179,6 +189,7 @@ pub fn lane_form(sim: &Simulation) -> Result<(DamperRun, LaneSettings), String> 
         attitude0: sim.attitude0,
         offset0: y0.get(7).copied().unwrap_or(f64::NAN),
         rate0: y0.get(8).copied().unwrap_or(f64::NAN),
+        spin_axis: sc.spin_axis,
         t_end: sim.duration,
         sample_rate: sim.output_rate,
     };
