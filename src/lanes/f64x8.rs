@@ -21,9 +21,10 @@
 use super::{Lane, LaneMask};
 use std::arch::x86_64::{
     __m512d, __mmask8, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm512_add_pd,
-    _mm512_and_epi64, _mm512_castpd_si512, _mm512_castsi512_pd, _mm512_cmp_pd_mask, _mm512_div_pd,
-    _mm512_loadu_pd, _mm512_mask_blend_pd, _mm512_mul_pd, _mm512_set1_epi64, _mm512_set1_pd,
-    _mm512_sqrt_pd, _mm512_storeu_pd, _mm512_sub_pd, _mm512_xor_epi64,
+    _mm512_and_epi64, _mm512_castpd_si512, _mm512_castsi512_pd, _mm512_cmp_pd_mask,
+    _mm512_cvtsd_f64, _mm512_div_pd, _mm512_loadu_pd, _mm512_mask_blend_pd, _mm512_mask_mov_pd,
+    _mm512_mul_pd, _mm512_permutexvar_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd,
+    _mm512_storeu_pd, _mm512_sub_pd, _mm512_xor_epi64,
 };
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
@@ -214,15 +215,20 @@ impl Lane for F64x8 {
         // SAFETY: AVX-512F: see the module.
         F64x8(unsafe { _mm512_set1_pd(x) })
     }
+    /// Lane `i` moved to the bottom by a permutation, in registers (a store of the whole
+    /// vector and a load of one lane would wait on store forwarding).
     #[inline(always)]
     fn lane(self, i: usize) -> f64 {
-        self.to_array()[i]
+        assert!(i < 8);
+        // SAFETY: AVX-512F: see the module.
+        unsafe { _mm512_cvtsd_f64(_mm512_permutexvar_pd(_mm512_set1_epi64(i as i64), self.0)) }
     }
+    /// `x` blended into lane `i` under a one-bit mask.
     #[inline(always)]
     fn with_lane(self, i: usize, x: f64) -> Self {
-        let mut a = self.to_array();
-        a[i] = x;
-        F64x8::from_array(a)
+        assert!(i < 8);
+        // SAFETY: AVX-512F: see the module.
+        F64x8(unsafe { _mm512_mask_mov_pd(self.0, 1 << i, _mm512_set1_pd(x)) })
     }
     #[inline(always)]
     fn gather_lane(values: &[Self], i: usize, out: &mut [f64]) {
