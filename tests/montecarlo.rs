@@ -1027,3 +1027,60 @@ fn a_campaign_of_many_blocks_streams_the_result_of_its_shards() {
         "the scatter's title names its thinning"
     );
 }
+
+/// Every lane width the processor has (and the scalar path) writes the same campaign
+/// directory; the header names the engine; a width that is not 1, 4 or 8, or one given with
+/// `--no-lanes`, is refused before anything is written.
+#[test]
+fn every_lane_width_writes_the_same_campaign() {
+    let dir = scratch("widths");
+    let scenario = "scenarios/nutation-damper.yaml";
+    let base = [scenario, "--runs", "24", "--threads", "2"];
+    let scalar = dir.join("scalar");
+    campaign(&[&base[..], &["--no-lanes"]].concat(), &scalar);
+    for width in ["1", "4", "8"] {
+        let out = dir.join(format!("w{width}"));
+        campaign(&[&base[..], &["--lane-width", width]].concat(), &out);
+        assert_same(&scalar, &out);
+    }
+    let o = polhode()
+        .args([
+            "montecarlo",
+            scenario,
+            "--runs",
+            "8",
+            "--lane-width",
+            "8",
+            "--out",
+        ])
+        .arg(dir.join("header"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let header = String::from_utf8_lossy(&o.stdout).into_owned() + &stderr(&o);
+    assert!(
+        header.contains("integrated in lockstep lane"),
+        "the header names the lanes: {header}"
+    );
+    for bad in [
+        vec!["--lane-width", "3"],
+        vec!["--lane-width", "4", "--no-lanes"],
+    ] {
+        let out = dir.join("refused");
+        let o = polhode()
+            .args(["montecarlo", scenario, "--runs", "8"])
+            .args(&bad)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains("--lane-width"),
+            "{bad:?}: {}",
+            stderr(&o)
+        );
+        assert!(!out.exists(), "{bad:?}: nothing written");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
