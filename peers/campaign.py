@@ -4,7 +4,7 @@ scenarios/nutation-damper.yaml (its `montecarlo:` block: 200 runs of 600 s, dopr
 1e-11, atol 1e-13, dispersed initial.omega[0], initial.omega[2] and the dashpot) three ways:
 
   lanes    polhode montecarlo SCENARIO --threads 1 --shard 1/1 --out TMP
-           (four runs at once in SIMD lanes, AVX2; shard 1/1 writes the table and the
+           (eight runs at once in SIMD lanes with AVX-512, four with AVX2; shard 1/1 writes the table and the
            summaries but no charts and no MCAP of the worst/median/best runs)
   scalar   the same with --no-lanes (one run after another; the same rows)
   SciPy    solve_ivp, RK45 (the same Dormand-Prince 5(4) pair) and DOP853, over the same
@@ -144,6 +144,7 @@ def versions():
         v["cpu"] = re.search(r"^model name\s*:\s*(.*)$", info, re.M)[1].strip()
         flags = re.search(r"^flags\s*:\s*(.*)$", info, re.M)[1].split()
         v["avx2"] = "avx2" in flags
+        v["avx512f"] = "avx512f" in flags
     except (OSError, TypeError):
         v["cpu"] = platform.processor()
     v["cores"] = os.cpu_count()

@@ -265,6 +265,7 @@ def block_campaign(camp):
         f"`{camp['scenario']}`, {c['runs']} runs of {c['duration']:g} s (seed {c['seed']}), "
         f"{c['method']} at rtol {c['rtol']:g}, atol {c['atol']:g}; {v.get('cpu', '?')}, "
         f"{v.get('cores', '?')} cores, AVX2 {'yes' if v.get('avx2') else 'no'}"
+        + (f", AVX-512 {'yes' if v['avx512f'] else 'no'}" if "avx512f" in v else "")
         + (f", load average {load[0]:.2f} at the start" if load else "")
         + f"; `{v.get('polhode', '?')}` (source of commit {v.get('polhode_commit', '?')}), SciPy {v['scipy']}. "
         f"polhode: best of {camp['repeats']} campaigns each way, alternated; SciPy: once.",
