@@ -518,8 +518,8 @@ impl<L: Lane> System<L> {
     /// `(x + y) + z`, its 4-vector norm `(i² + k²) + (j² + w²)` and its rotation
     /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
     /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0). Then
-    /// `Observation::from_invariants`'s |H| and the nutation angle's two arguments (its
-    /// arctangent stays per lane: the platform's `atan2`).
+    /// |H| (as `Observation::from_invariants` takes it) and the nutation angle's two
+    /// arguments (its arctangent stays per lane: the platform's `atan2`).
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
         use linalg::cross;

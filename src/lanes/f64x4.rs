@@ -214,68 +214,36 @@ impl Lane for F64x4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::operations_check::{
+        every_lane_is_the_f64_operation, masks_combine_lane_by_lane,
+    };
 
-    /// Each lane of every operation equals the f64 operation on that lane, bit for bit,
-    /// on values that include signed zeros, subnormals, infinities and NaN.
+    /// On values that include signed zeros, subnormals, infinities and NaN.
     #[test]
-    fn every_lane_is_the_f64_operation() {
-        let values = [
-            0.0,
-            -0.0,
-            1.5,
-            -2.25,
-            1e-310,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NAN,
-            3.0e300,
-            7.0,
-        ];
-        let same = |a: f64, b: f64| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
-        for (k, &x0) in values.iter().enumerate() {
-            let xs = [
-                x0,
-                values[(k + 3) % 10],
-                values[(k + 5) % 10],
-                values[(k + 7) % 10],
-            ];
-            for &y0 in &values {
-                let ys = [y0, values[(k + 1) % 10], x0, values[(k + 9) % 10]];
-                let (x, y) = (F64x4(xs), F64x4(ys));
-                for i in 0..4 {
-                    let (a, b) = (xs[i], ys[i]);
-                    assert!(same((x + y).lane(i), a + b));
-                    assert!(same((x - y).lane(i), a - b));
-                    assert!(same((x * y).lane(i), a * b));
-                    assert!(same((x / y).lane(i), a / b));
-                    assert!(same((-x).lane(i), -a));
-                    assert!(same(x.abs().lane(i), a.abs()));
-                    assert!(same(x.sqrt().lane(i), a.sqrt()));
-                    assert!(same(x.max(y).lane(i), a.max(b)));
-                    assert!(same(x.min(y).lane(i), a.min(b)));
-                    assert!(same(x.clamp(0.1, 5.0).lane(i), a.clamp(0.1, 5.0)));
-                    assert!(same(x.powf(0.17).lane(i), a.powf(0.17)));
-                    assert_eq!(x.less_than(y).test(i), a < b);
-                    assert_eq!(x.at_most(y).test(i), a <= b);
-                    assert_eq!(x.greater_than(y).test(i), a > b);
-                    assert_eq!(x.at_least(y).test(i), a >= b);
-                    assert_eq!(x.equals(y).test(i), a == b);
-                    assert_eq!(x.is_finite().test(i), a.is_finite());
-                    let m = x.less_than(y);
-                    let chosen = if a < b { a } else { b };
-                    assert!(same(F64x4::select(m, x, y).lane(i), chosen));
-                }
-            }
+    fn every_lane_is_the_f64_operation_in_sse2_registers() {
+        every_lane_is_the_f64_operation::<F64x4>();
+    }
+
+    /// The same compiled for AVX2, as the engine runs, where the processor has it.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn every_lane_is_the_f64_operation_in_avx2_registers() {
+        #[target_feature(enable = "avx2")]
+        fn check() {
+            every_lane_is_the_f64_operation::<F64x4>();
+        }
+        if crate::cpu::avx2_available() {
+            // SAFETY: the processor has AVX2.
+            unsafe { check() }
         }
     }
 
     #[test]
-    fn masks_combine_lane_by_lane() {
-        let a = M64x4::from_bools([true, false, true, false]);
-        let b = M64x4::from_bools([true, true, false, false]);
-        assert_eq!(a & b, M64x4::from_bools([true, false, false, false]));
-        assert_eq!(a | b, M64x4::from_bools([true, true, true, false]));
-        assert_eq!(!a, M64x4::from_bools([false, true, false, true]));
-        assert!(a.any() && !a.all() && M64x4::splat(true).all() && !M64x4::splat(false).any());
+    fn masks_combine_lane_by_lane_of_four() {
+        masks_combine_lane_by_lane::<F64x4>();
+        assert_eq!(
+            M64x4::from_bools([true, false, true, false]),
+            M64x4([!0, 0, !0, 0])
+        );
     }
 }

@@ -301,106 +301,33 @@ impl Lane for F64x8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lanes::operations_check::{
+        every_lane_is_the_f64_operation, masks_combine_lane_by_lane,
+    };
 
-    fn same(a: f64, b: f64) -> bool {
-        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
-    }
-
-    /// Each lane of every operation equals the f64 operation on that lane, bit for bit, on
-    /// values that include signed zeros, subnormals, infinities and NaN.
+    /// Lane i is bit i of a comparison's mask.
     #[target_feature(enable = "avx512f")]
-    fn every_lane_is_the_f64_operation() {
-        let values = [
-            0.0,
-            -0.0,
-            1.5,
-            -2.25,
-            1e-310,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NAN,
-            3.0e300,
-            7.0,
-        ];
-        for (k, &x0) in values.iter().enumerate() {
-            let xs: [f64; 8] = std::array::from_fn(|i| {
-                if i == 0 {
-                    x0
-                } else {
-                    values[(k + 2 * i + 1) % 10]
-                }
-            });
-            for &y0 in &values {
-                let ys: [f64; 8] = std::array::from_fn(|i| match i {
-                    0 => y0,
-                    2 => x0,
-                    _ => values[(k + 3 * i + 1) % 10],
-                });
-                let (x, y) = (F64x8::from_array(xs), F64x8::from_array(ys));
-                for i in 0..8 {
-                    let (a, b) = (xs[i], ys[i]);
-                    assert!(same((x + y).lane(i), a + b));
-                    assert!(same((x - y).lane(i), a - b));
-                    assert!(same((x * y).lane(i), a * b));
-                    assert!(same((x / y).lane(i), a / b));
-                    assert!(same((-x).lane(i), -a));
-                    assert!(same(x.abs().lane(i), a.abs()));
-                    assert!(same(x.sqrt().lane(i), a.sqrt()));
-                    assert!(same(x.max(y).lane(i), a.max(b)));
-                    assert!(same(x.min(y).lane(i), a.min(b)));
-                    assert!(same(x.clamp(0.1, 5.0).lane(i), a.clamp(0.1, 5.0)));
-                    assert!(same(x.powf(0.17).lane(i), a.powf(0.17)));
-                    assert_eq!(x.less_than(y).test(i), a < b);
-                    assert_eq!(x.at_most(y).test(i), a <= b);
-                    assert_eq!(x.greater_than(y).test(i), a > b);
-                    assert_eq!(x.at_least(y).test(i), a >= b);
-                    assert_eq!(x.equals(y).test(i), a == b);
-                    assert_eq!(x.is_finite().test(i), a.is_finite());
-                    let chosen = if a < b { a } else { b };
-                    assert!(same(F64x8::select(x.less_than(y), x, y).lane(i), chosen));
-                    assert!(same(x.with_lane(i, b).lane(i), b));
-                    let mut one = [0.0];
-                    F64x8::gather_lane(&[x], i, &mut one);
-                    assert!(same(one[0], a));
-                }
-            }
-        }
-    }
-
-    #[target_feature(enable = "avx512f")]
-    fn masks_combine_lane_by_lane() {
-        let pattern = |bits: [bool; 4]| -> M64x8 {
-            (0..8).fold(M64x8::splat(false), |m, i| m.with_lane(i, bits[i % 4]))
-        };
-        let a = pattern([true, false, true, false]);
-        let b = pattern([true, true, false, false]);
-        for i in 0..8 {
-            assert_eq!((a & b).test(i), [true, false, false, false][i % 4]);
-            assert_eq!((a | b).test(i), [true, true, true, false][i % 4]);
-            assert_eq!((!a).test(i), [false, true, false, true][i % 4]);
-        }
-        assert!(a.any() && !a.all());
-        assert!(M64x8::splat(true).all() && !M64x8::splat(false).any());
-        let last = M64x8::splat(false).with_lane(7, true);
-        assert!(last.any() && !last.all() && last.test(7) && !last.test(6));
+    fn lane_i_is_bit_i() {
         let x = F64x8::from_array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]);
-        assert_eq!(
-            x.less_than(F64x8::splat(4.5)),
-            M64x8(0b0000_1111),
-            "lane i is bit i"
-        );
+        assert_eq!(x.less_than(F64x8::splat(4.5)), M64x8(0b0000_1111));
     }
 
+    /// Each operation on values that include signed zeros, subnormals, infinities and NaN.
     #[test]
     fn eight_lanes_are_the_f64_operations_where_the_processor_has_avx512() {
+        #[target_feature(enable = "avx512f")]
+        fn check() {
+            every_lane_is_the_f64_operation::<F64x8>();
+            masks_combine_lane_by_lane::<F64x8>();
+        }
         if !crate::cpu::avx512_available() {
             eprintln!("no AVX-512F on this processor: nothing to test");
             return;
         }
         // SAFETY: the processor has AVX-512F.
         unsafe {
-            every_lane_is_the_f64_operation();
-            masks_combine_lane_by_lane();
+            check();
+            lane_i_is_bit_i();
         }
     }
 }

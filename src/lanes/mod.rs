@@ -27,6 +27,8 @@ pub mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;
 pub mod linalg;
+#[cfg(test)]
+mod operations_check;
 
 pub use f64x4::{F64x4, M64x4};
 

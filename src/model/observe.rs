@@ -179,32 +179,19 @@ pub(super) fn angles_to_principal(sc: &Spacecraft, omega: &Vector3<f64>) -> [f64
 /// The observation at state `y`; its angles to the principal axes are NaN unless `angles`.
 pub(super) fn observe(sc: &Spacecraft, t: f64, y: &[f64], angles: bool) -> Observation {
     let (inv, attitude) = invariants(sc, t, y);
-    Observation::from_invariants(sc, t, y, &inv, attitude, angles)
+    let h_norm = inv.h_body.norm();
+    let nutation_angle = angle_between(&sc.spin_axis, &inv.h_body);
+    Observation::from_invariants(sc, t, y, &inv, attitude, angles, h_norm, nutation_angle)
 }
 
 impl Observation {
     /// The observation of `sc` at state `y` (time `t`, s) whose invariants and attitude are
     /// already known (as [`Spacecraft::invariants`] gives them, or the same computed
-    /// elsewhere bit for bit): the rest is derived here. Its angles to the principal axes are
-    /// NaN unless `angles`.
-    pub(crate) fn from_invariants(
-        sc: &Spacecraft,
-        t: f64,
-        y: &[f64],
-        inv: &Invariants,
-        attitude: UnitQuaternion<f64>,
-        angles: bool,
-    ) -> Observation {
-        let h_norm = inv.h_body.norm();
-        let nutation_angle = angle_between(&sc.spin_axis, &inv.h_body);
-        Observation::from_parts(sc, t, y, inv, attitude, angles, h_norm, nutation_angle)
-    }
-
-    /// [`Observation::from_invariants`] with |H| (`h_body`'s norm) and the nutation angle
-    /// (`angle_between` the spin axis and `h_body`) already computed, as the lanes compute
-    /// them.
+    /// elsewhere bit for bit), with |H| (`h_body`'s norm) and the nutation angle
+    /// ([`angle_between`] the spin axis and `h_body`), which the lanes compute themselves:
+    /// the rest is derived here. Its angles to the principal axes are NaN unless `angles`.
     #[allow(clippy::too_many_arguments)] // the parts of one observation
-    pub(crate) fn from_parts(
+    pub(crate) fn from_invariants(
         sc: &Spacecraft,
         t: f64,
         y: &[f64],

@@ -128,7 +128,7 @@ fn observation(
     };
     let attitude = UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k));
     let nutation_angle = angle_from(lane.nutation_sine, lane.nutation_cosine);
-    Observation::from_parts(
+    Observation::from_invariants(
         sc,
         t,
         y,
