@@ -366,8 +366,8 @@ pub enum Engine {
     /// Four lanes compiled for AVX2; falls back to [`Engine::Scalar`] on a processor
     /// without it.
     Avx2,
-    /// Eight lanes in AVX-512 registers (intrinsics, x86-64 only); falls back to [`Engine::Avx2`] (and on to
-    /// [`Engine::Scalar`]) on a processor without it.
+    /// Eight lanes in AVX-512 registers (intrinsics, x86-64 only); falls back to
+    /// [`Engine::Avx2`] (and on to [`Engine::Scalar`]) on a processor without it.
     Avx512,
 }
 
