@@ -243,12 +243,6 @@ struct DriftReference<L: Lane> {
     e0: L,
 }
 
-/// `√(0 + ((x² + y²) + z²))`: nalgebra's `Vector3::norm`, per lane.
-#[inline(always)]
-fn norm<L: Lane>(v: [L; 3]) -> L {
-    (L::splat(0.0) + linalg::dot(v, v)).sqrt()
-}
-
 /// `d / reference`, or `d` where the reference is zero (the monitor's `rel`).
 #[inline(always)]
 fn relative<L: Lane>(d: L, reference: L) -> L {
@@ -266,15 +260,14 @@ impl<L: Lane> LaneObservation<L> {
     /// H_N plus the (zero) momentum carried out, as the monitor audits it.
     #[inline(always)]
     fn h_audited(&self) -> [L; 3] {
-        let zero = L::splat(0.0);
-        linalg::each3(|k| self.h_inertial[k] + zero)
+        linalg::add(self.h_inertial, [L::splat(0.0); 3])
     }
 
     /// What the drift of later states is measured against, this being the state at t = 0.
     #[inline(always)]
     fn drift_reference(&self) -> DriftReference<L> {
         DriftReference {
-            h0: norm(self.h_body),
+            h0: linalg::norm(self.h_body),
             h_inertial0: self.h_inertial,
             e0: self.energy_balance(),
         }
@@ -286,8 +279,8 @@ impl<L: Lane> LaneObservation<L> {
         let r = reference;
         let h = self.h_audited();
         LaneDrift {
-            h_norm_rel: relative(norm(h) - r.h0, r.h0).abs(),
-            h_inertial_rel: relative(norm(linalg::each3(|k| h[k] - r.h_inertial0[k])), r.h0),
+            h_norm_rel: relative(linalg::norm(h) - r.h0, r.h0).abs(),
+            h_inertial_rel: relative(linalg::norm(linalg::sub(h, r.h_inertial0)), r.h0),
             energy_rel: relative(self.energy_balance() - r.e0, r.e0).abs(),
             q_norm: self.q_norm_error.abs(),
         }
@@ -574,8 +567,8 @@ impl<L: Lane> System<L> {
             elastic_energy: zero + half * d.stiffness * q * q,
             dissipated_energy: zero + y[9],
             dissipation_power: zero + d.damping * u * u,
-            h_norm: norm(h),
-            nutation_sine: norm(cross(a, h)),
+            h_norm: linalg::norm(h),
+            nutation_sine: linalg::norm(cross(a, h)),
             nutation_cosine: linalg::dot(a, h),
         }
     }

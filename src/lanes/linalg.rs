@@ -15,6 +15,12 @@ pub fn dot<L: Lane>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// `|a|` as nalgebra's `Vector3::norm` rounds it: `√(0 + ((x² + y²) + z²))`.
+#[inline(always)]
+pub fn norm<L: Lane>(a: [L; 3]) -> L {
+    (L::splat(0.0) + dot(a, a)).sqrt()
+}
+
 /// `a × b`.
 #[inline(always)]
 pub fn cross<L: Lane>(a: [L; 3], b: [L; 3]) -> [L; 3] {
