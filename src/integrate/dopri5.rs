@@ -6,6 +6,7 @@
 
 use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine};
 use crate::lanes::Lane;
+use crate::lanes::elementary::positive_powf;
 
 const C2: f64 = 1.0 / 5.0;
 const C3: f64 = 3.0 / 10.0;
@@ -389,11 +390,11 @@ pub(crate) fn dense_interior<L: Lane, C: AsRef<[L]>>(
     }
 }
 
-/// `err^(1/5 − 0.75 β)`, the error's factor in the step-size control, per lane (through the
-/// platform's `pow`, lane by lane).
+/// `err^(1/5 − 0.75 β)`, the error's factor in the step-size control, per lane (the lanes'
+/// own power, [`positive_powf`], the same at every width).
 #[inline(always)]
 pub(crate) fn error_factor<L: Lane>(err: L) -> L {
-    err.powf(0.2 - 0.75 * BETA)
+    positive_powf(err, 0.2 - 0.75 * BETA)
 }
 
 /// After an accepted step `h` (s) with error `err` and its factor `fac11`
@@ -407,7 +408,7 @@ pub(crate) fn accepted_step_size<L: Lane>(
     fac_old: L,
     after_rejections: L::Mask,
 ) -> (L, L) {
-    let fac = fac11 / fac_old.powf(BETA);
+    let fac = fac11 / positive_powf(fac_old, BETA);
     let fac = (fac / L::splat(SAFETY)).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
     let h_new = h / fac;
     let h_new = L::select(after_rejections, h_new.min(h), h_new);

@@ -24,6 +24,7 @@
 //! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
 //! here: breakpoints (a scene with one does not take this class).
 
+use super::elementary::half_plane_atan2;
 use super::{F64x4, Lane, LaneMask, linalg};
 use crate::effectors::spring_mass::{SpringMass, SpringMassLanes};
 use crate::integrate::dopri5::{
@@ -172,11 +173,10 @@ pub struct LaneObservation<T = f64> {
     pub dissipation_power: T,
     /// |H| (N m s), nalgebra's norm of `h_body`.
     pub h_norm: T,
-    /// |a × H| and a · H, a the spin axis (N m s): the nutation angle is
-    /// `nutation_sine.atan2(nutation_cosine)`, as `observe::angle_between` forms it.
-    pub nutation_sine: T,
-    /// See [`LaneObservation::nutation_sine`].
-    pub nutation_cosine: T,
+    /// The nutation angle (rad), between the spin axis a and H, from |a × H| and a · H, as
+    /// `observe::angle_between` forms it (the arctangent in the lanes:
+    /// [`crate::lanes::elementary::half_plane_atan2`]).
+    pub nutation_angle: T,
 }
 
 impl<L: Lane> LaneObservation<L> {
@@ -190,8 +190,7 @@ impl<L: Lane> LaneObservation<L> {
             dissipated_energy: self.dissipated_energy.lane(i),
             dissipation_power: self.dissipation_power.lane(i),
             h_norm: self.h_norm.lane(i),
-            nutation_sine: self.nutation_sine.lane(i),
-            nutation_cosine: self.nutation_cosine.lane(i),
+            nutation_angle: self.nutation_angle.lane(i),
             ..LaneObservation::default()
         };
         L::gather_lane(&self.attitude, i, &mut o.attitude);
@@ -568,8 +567,7 @@ impl<L: Lane> System<L> {
             dissipated_energy: zero + y[9],
             dissipation_power: zero + d.damping * u * u,
             h_norm: linalg::norm(h),
-            nutation_sine: linalg::norm(cross(a, h)),
-            nutation_cosine: linalg::dot(a, h),
+            nutation_angle: half_plane_atan2(linalg::norm(cross(a, h)), linalg::dot(a, h)),
         }
     }
 }

@@ -178,6 +178,15 @@ impl Lane for F64x4 {
         map(self, |a| a.powf(e))
     }
     #[inline(always)]
+    fn mantissa_exponent(self) -> (Self, Self) {
+        let pairs = self.0.map(super::scalar_mantissa_exponent);
+        (F64x4(pairs.map(|p| p.0)), F64x4(pairs.map(|p| p.1)))
+    }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        map(self, super::scalar_pow2)
+    }
+    #[inline(always)]
     fn less_than(self, o: Self) -> M64x4 {
         compare(self, o, |a, b| a < b)
     }
@@ -215,13 +224,14 @@ impl Lane for F64x4 {
 mod tests {
     use super::*;
     use crate::lanes::operations_check::{
-        every_lane_is_the_f64_operation, masks_combine_lane_by_lane,
+        every_lane_is_the_f64_operation, masks_combine_lane_by_lane, powers_of_two_are_exact,
     };
 
     /// On values that include signed zeros, subnormals, infinities and NaN.
     #[test]
     fn every_lane_is_the_f64_operation_in_sse2_registers() {
         every_lane_is_the_f64_operation::<F64x4>();
+        powers_of_two_are_exact::<F64x4>();
     }
 
     /// The same compiled for AVX2, as the engine runs, where the processor has it.
@@ -231,6 +241,7 @@ mod tests {
         #[target_feature(enable = "avx2")]
         fn check() {
             every_lane_is_the_f64_operation::<F64x4>();
+            powers_of_two_are_exact::<F64x4>();
         }
         if crate::cpu::avx2_available() {
             // SAFETY: the processor has AVX2.

@@ -20,10 +20,11 @@
 
 use super::{Lane, LaneMask};
 use std::arch::x86_64::{
-    __m512d, __mmask8, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ, _mm512_add_pd,
-    _mm512_and_epi64, _mm512_castpd_si512, _mm512_castsi512_pd, _mm512_cmp_pd_mask,
-    _mm512_cvtsd_f64, _mm512_div_pd, _mm512_loadu_pd, _mm512_mask_blend_pd, _mm512_mask_mov_pd,
-    _mm512_mul_pd, _mm512_permutexvar_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd,
+    __m512d, __mmask8, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
+    _MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC, _mm512_add_pd, _mm512_and_epi64, _mm512_castpd_si512,
+    _mm512_castsi512_pd, _mm512_cmp_pd_mask, _mm512_cvtsd_f64, _mm512_div_pd, _mm512_getexp_pd,
+    _mm512_getmant_pd, _mm512_loadu_pd, _mm512_mask_blend_pd, _mm512_mask_mov_pd, _mm512_mul_pd,
+    _mm512_permutexvar_pd, _mm512_scalef_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd,
     _mm512_storeu_pd, _mm512_sub_pd, _mm512_xor_epi64,
 };
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
@@ -264,6 +265,25 @@ impl Lane for F64x8 {
     fn powf(self, e: f64) -> Self {
         self.map(|a| a.powf(e))
     }
+    /// `vgetmantpd` (normalised to [1, 2)) and `vgetexppd`: both exact, subnormals included.
+    #[inline(always)]
+    fn mantissa_exponent(self) -> (Self, Self) {
+        // SAFETY: AVX-512F: see the module.
+        unsafe {
+            (
+                F64x8(_mm512_getmant_pd::<_MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC>(
+                    self.0,
+                )),
+                F64x8(_mm512_getexp_pd(self.0)),
+            )
+        }
+    }
+    /// `vscalefpd` of 1: 1·2^⌊k⌋, exact in the range.
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        // SAFETY: AVX-512F: see the module.
+        F64x8(unsafe { _mm512_scalef_pd(_mm512_set1_pd(1.0), self.0) })
+    }
     #[inline(always)]
     fn less_than(self, o: Self) -> M64x8 {
         compare!(self, o, _CMP_LT_OQ)
@@ -302,7 +322,7 @@ impl Lane for F64x8 {
 mod tests {
     use super::*;
     use crate::lanes::operations_check::{
-        every_lane_is_the_f64_operation, masks_combine_lane_by_lane,
+        every_lane_is_the_f64_operation, masks_combine_lane_by_lane, powers_of_two_are_exact,
     };
 
     /// Lane i is bit i of a comparison's mask.
@@ -318,6 +338,7 @@ mod tests {
         #[target_feature(enable = "avx512f")]
         fn check() {
             every_lane_is_the_f64_operation::<F64x8>();
+            powers_of_two_are_exact::<F64x8>();
             masks_combine_lane_by_lane::<F64x8>();
         }
         if !crate::cpu::avx512_available() {

@@ -17,12 +17,15 @@
 //!
 //! Layout: [`f64x4`] (four lanes as a plain array, and its mask), `f64x8` (eight lanes in an
 //! AVX-512 register, x86-64 only, crate-private), [`linalg`] (3-vectors,
-//! 3 × 3 products, the SPD inverse and the quaternion rate, in lanes), [`damper`] (the
+//! 3 × 3 products, the SPD inverse and the quaternion rate, in lanes), [`elementary`] (the
+//! arctangent and the power that the monitor and the step-size control call every step, in
+//! lanes and at f64 alike), [`damper`] (the
 //! lockstep dopri5 ensemble of the nutation-damper class, with the AVX2 and AVX-512
 //! dispatch). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;
+pub mod elementary;
 pub mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;
@@ -94,6 +97,11 @@ pub trait Lane:
     /// `f64::powf(e)` per lane: the platform's `pow`, one lane at a time (not vectorised, so
     /// that the bits are those of the scalar call).
     fn powf(self, e: f64) -> Self;
+    /// For x > 0 finite (subnormals included): the mantissa m in [1, 2) and the exponent k
+    /// (an integer, as f64) with x = m·2^k exactly. Unspecified, but no fault, elsewhere.
+    fn mantissa_exponent(self) -> (Self, Self);
+    /// 2^k for an integer k in [−1022, 1023] (exact). Unspecified, but no fault, elsewhere.
+    fn pow2(self) -> Self;
     /// `self < other` per lane (false where either is NaN).
     fn less_than(self, other: Self) -> Self::Mask;
     /// `self <= other` per lane.
@@ -108,6 +116,27 @@ pub trait Lane:
     fn is_finite(self) -> Self::Mask;
     /// `a` where `mask` is true, `b` elsewhere.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+}
+
+/// [`Lane::mantissa_exponent`] of one f64, from its bits (a subnormal is scaled by 2⁵⁴ first).
+#[inline(always)]
+pub(crate) fn scalar_mantissa_exponent(x: f64) -> (f64, f64) {
+    const TWO_TO_54: f64 = 18_014_398_509_481_984.0;
+    let (x, scaled) = if x < f64::MIN_POSITIVE {
+        (x * TWO_TO_54, 54.0)
+    } else {
+        (x, 0.0)
+    };
+    let bits = x.to_bits();
+    let biased = ((bits >> 52) & 0x7ff) as f64;
+    let mantissa = f64::from_bits((bits & ((1 << 52) - 1)) | (1023 << 52));
+    (mantissa, biased - 1023.0 - scaled)
+}
+
+/// [`Lane::pow2`] of one f64, by writing the biased exponent.
+#[inline(always)]
+pub(crate) fn scalar_pow2(k: f64) -> f64 {
+    f64::from_bits(((k as i64 + 1023) as u64 & 0x7ff) << 52)
 }
 
 impl LaneMask for bool {
@@ -172,6 +201,14 @@ impl Lane for f64 {
     #[inline(always)]
     fn powf(self, e: f64) -> Self {
         f64::powf(self, e)
+    }
+    #[inline(always)]
+    fn mantissa_exponent(self) -> (Self, Self) {
+        scalar_mantissa_exponent(self)
+    }
+    #[inline(always)]
+    fn pow2(self) -> Self {
+        scalar_pow2(self)
     }
     #[inline(always)]
     fn less_than(self, other: Self) -> bool {

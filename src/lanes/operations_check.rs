@@ -62,6 +62,13 @@ pub(crate) fn every_lane_is_the_f64_operation<L: Lane>() {
                 assert!(same(x.min(y).lane(i), a.min(b)));
                 assert!(same(x.clamp(0.1, 5.0).lane(i), a.clamp(0.1, 5.0)));
                 assert!(same(x.powf(0.17).lane(i), a.powf(0.17)));
+                if a > 0.0 && a.is_finite() {
+                    let (m, k) = x.mantissa_exponent();
+                    let expected = super::scalar_mantissa_exponent(a);
+                    assert!(same(m.lane(i), expected.0) && same(k.lane(i), expected.1));
+                    assert!((1.0..2.0).contains(&expected.0));
+                    assert_eq!(expected.0 * 2f64.powf(expected.1), a);
+                }
                 assert_eq!(x.less_than(y).test(i), a < b);
                 assert_eq!(x.at_most(y).test(i), a <= b);
                 assert_eq!(x.greater_than(y).test(i), a > b);
@@ -75,6 +82,20 @@ pub(crate) fn every_lane_is_the_f64_operation<L: Lane>() {
                 L::gather_lane(&[x], i, &mut one);
                 assert!(same(one[0], a));
             }
+        }
+    }
+}
+
+/// 2^k for every integer k in [−1022, 1023], exactly, in every lane.
+#[inline(always)]
+pub(crate) fn powers_of_two_are_exact<L: Lane>() {
+    for k in -1022..=1023 {
+        let ks: Vec<f64> = (0..L::WIDTH)
+            .map(|i| (k - i as i32).max(-1022) as f64)
+            .collect();
+        let p = vector::<L>(&ks).pow2();
+        for (i, &kf) in ks.iter().enumerate() {
+            assert_eq!(p.lane(i), 2f64.powi(kf as i32), "2^{kf}");
         }
     }
 }

@@ -72,9 +72,10 @@ pub fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 }
 
 /// The angle between two vectors a and b (rad) from |a × b| and a · b, as [`angle_between`]
-/// forms it.
+/// forms it: the arctangent of the lanes ([`crate::lanes::elementary::half_plane_atan2`],
+/// within one unit in the last place), so that the lanes' angles are the scalar path's.
 pub fn angle_from(cross_norm: f64, dot: f64) -> f64 {
-    cross_norm.atan2(dot)
+    crate::lanes::elementary::half_plane_atan2(cross_norm, dot)
 }
 
 /// The conserved quantities only: what drift tracking needs at every step.
@@ -190,6 +191,7 @@ impl Observation {
     /// elsewhere bit for bit), with |H| (`h_body`'s norm) and the nutation angle
     /// ([`angle_between`] the spin axis and `h_body`), which the lanes compute themselves:
     /// the rest is derived here. Its angles to the principal axes are NaN unless `angles`.
+    #[inline]
     #[allow(clippy::too_many_arguments)] // the parts of one observation
     pub(crate) fn from_invariants(
         sc: &Spacecraft,
@@ -201,15 +203,18 @@ impl Observation {
         h_norm: f64,
         nutation_angle: f64,
     ) -> Observation {
-        let omega = Vector3::new(y[0], y[1], y[2]);
+        // The calls first and ω last, read straight into the observation: ω held across
+        // the calls went through the stack in pieces and was read back whole, a load that
+        // waited on store forwarding (6 % of a lane campaign's time).
+        let field_angle = field_angle(sc, t, y);
         let angles_to_principal = if angles {
-            angles_to_principal(sc, &omega)
+            angles_to_principal(sc, &Vector3::new(y[0], y[1], y[2]))
         } else {
             [f64::NAN; 3]
         };
         Observation {
             t,
-            omega,
+            omega: Vector3::new(y[0], y[1], y[2]),
             attitude,
             q_norm_error: inv.q_norm_error,
             h_body: inv.h_body,
@@ -223,7 +228,7 @@ impl Observation {
             external_work: inv.external_work,
             nutation_angle,
             angles_to_principal,
-            field_angle: field_angle(sc, t, y),
+            field_angle,
         }
     }
 }

@@ -16,7 +16,7 @@ use crate::lanes::damper::{
     DIM, DamperRun, DenseOutput, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
     integrate_runs_observed_with,
 };
-use crate::model::{Invariants, Observation, Spacecraft, angle_from};
+use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
 use std::cell::OnceCell;
@@ -127,7 +127,6 @@ fn observation(
         q_norm_error: lane.q_norm_error,
     };
     let attitude = UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k));
-    let nutation_angle = angle_from(lane.nutation_sine, lane.nutation_cosine);
     Observation::from_invariants(
         sc,
         t,
@@ -136,7 +135,7 @@ fn observation(
         attitude,
         angles,
         lane.h_norm,
-        nutation_angle,
+        lane.nutation_angle,
     )
 }
 
