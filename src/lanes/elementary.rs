@@ -10,8 +10,8 @@
 //! `f64`: the scalar path calls the same functions and the two paths still agree to the bit.
 //! They are not the platform's functions and may differ from them in the last place:
 //! `half_plane_atan2` by at most one unit in the last place from the correctly rounded
-//! arctangent, `positive_powf` by two where the step-size control calls it (docs/montecarlo.md, "Elementary functions in the
-//! lanes", gives the bounds and the tests).
+//! arctangent, `positive_powf` by two where the step-size control calls it
+//! (docs/montecarlo.md, "Elementary functions in the lanes", gives the bounds and the tests).
 //!
 //! Both are series with exact coefficients after an argument reduction: the arctangent's
 //! Taylor series `atan u = u − u³/3 + u⁵/5 − …` above the largest `tan(jπ/16)` ≤ z,
