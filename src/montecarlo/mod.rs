@@ -1012,6 +1012,10 @@ impl Sink for Extremes {
     fn reads_principal_angles(&self) -> bool {
         false
     }
+    fn nutation_sample(&mut self, _t: f64, nutation_angle: f64) -> Option<std::io::Result<()>> {
+        self.max_nutation = self.max_nutation.max(nutation_angle);
+        Some(Ok(()))
+    }
 }
 
 #[cfg(test)]

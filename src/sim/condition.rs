@@ -67,7 +67,12 @@ pub struct Condition {
 impl Condition {
     /// Signed distance from the threshold: positive while the condition holds.
     pub fn margin(&self, o: &Observation) -> f64 {
-        let d = self.quantity.value(o) - self.threshold;
+        self.margin_of_value(self.quantity.value(o))
+    }
+
+    /// [`Condition::margin`] of a value of the quantity (in its unit).
+    pub fn margin_of_value(&self, value: f64) -> f64 {
+        let d = value - self.threshold;
         if self.above { d } else { -d }
     }
 

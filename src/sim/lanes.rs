@@ -8,7 +8,9 @@
 //! has none; such a run, or one the lanes decline part-way, takes the scalar path.
 
 use super::monitor::{Monitor, StepView};
-use super::{Drift, Method, Outcome, Simulation, Sink, Status, diagnose, interior_checks};
+use super::{
+    Drift, Method, Outcome, Quantity, Simulation, Sink, Status, diagnose, interior_checks,
+};
 use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
@@ -82,6 +84,25 @@ impl StepView for LaneView<'_> {
             energy_rel: d.energy_rel,
             q_norm: d.q_norm,
         })
+    }
+    /// The quantities the lanes computed at the step's end, as `Quantity::value` reads them
+    /// from the observation formed of them (`observation`): ω from the state, the kinetic
+    /// energy and the nutation angle from the lanes' observation.
+    fn end_value(&self, quantity: Quantity) -> Option<f64> {
+        let end = &self.step.end;
+        match quantity {
+            Quantity::NutationAngleDeg => Some(end.nutation_angle.to_degrees()),
+            Quantity::Omega(i) => Some(self.step.y[i]),
+            Quantity::KineticEnergy => Some(end.kinetic_energy),
+            _ => None,
+        }
+    }
+    fn nutation_at(&self, t: f64) -> Option<f64> {
+        if t.to_bits() == self.step.t.to_bits() {
+            return Some(self.step.end.nutation_angle);
+        }
+        let sample = self.step.sample.as_ref()?;
+        (sample.t.to_bits() == t.to_bits()).then_some(sample.observation.nutation_angle)
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
         let step = self.step;

@@ -208,6 +208,12 @@ pub trait Sink {
     fn reads_principal_angles(&self) -> bool {
         true
     }
+    /// A sample of which this sink may read only the nutation angle (rad) at `t` (s), offered
+    /// where the integrator has the angle without forming the observation (a campaign's
+    /// lanes). `None`: this sink reads more, and [`Sink::sample`] is called instead.
+    fn nutation_sample(&mut self, _t: f64, _nutation_angle: f64) -> Option<std::io::Result<()>> {
+        None
+    }
 }
 
 /// A sink that discards everything (runs without logging).
@@ -631,6 +637,7 @@ fn keep_event(events: &mut Vec<EventRecord>, not_kept: &mut u64, e: EventRecord)
 }
 
 /// The first invariant (index, description) beyond its bound and not yet warned about.
+#[inline]
 fn drift_excess(
     limits: &DriftLimits,
     drift: &Drift,

@@ -34,6 +34,18 @@ pub(crate) trait StepView {
     fn end_observation(&self, _sc: &Spacecraft, _angles: bool) -> Option<Observation> {
         None
     }
+    /// The value of `quantity` at the end of the step, if the integrator has it without
+    /// forming the observation there (as `quantity.value` of that observation would give it,
+    /// bit for bit).
+    fn end_value(&self, _quantity: Quantity) -> Option<f64> {
+        None
+    }
+    /// The nutation angle (rad) at `t`, the step's end or a time inside it, if the
+    /// integrator has it without forming the observation there (as that observation's
+    /// `nutation_angle`, bit for bit).
+    fn nutation_at(&self, _t: f64) -> Option<f64> {
+        None
+    }
     /// The drift at the end of the step from the run's start, if the integrator computed it
     /// already (as `Reference::terms` of the end state's invariants would, bit for bit).
     fn end_drift(&self) -> Option<Drift> {
@@ -306,17 +318,24 @@ impl<'a> Monitor<'a> {
                 diagnosis: diagnose(&what, t_good, buf, sim),
             }));
         }
-        // The full observation (angles) only when events need it; the drift check reads
-        // its invariants then, and computes them alone otherwise.
-        let o1 = if watches.is_empty() {
-            None
-        } else {
-            Some(
-                stepper
-                    .end_observation(sc, watched_angles)
-                    .unwrap_or_else(|| observe_for_events(t1, stepper.y())),
-            )
-        };
+        // Each watch's margin at the step's end, from the value the stepper hands where it has
+        // it (the lanes), from the observation there otherwise: formed once, only then (with
+        // the angles when a watch needs them). The drift check reads its invariants if it
+        // was formed, and computes them alone otherwise.
+        let mut o1: Option<Observation> = None;
+        end_margins.clear();
+        for watch in watches.iter() {
+            let c = watch.condition;
+            let value = match stepper.end_value(c.quantity) {
+                Some(v) => v,
+                None => c.quantity.value(o1.get_or_insert_with(|| {
+                    stepper
+                        .end_observation(sc, watched_angles)
+                        .unwrap_or_else(|| observe_for_events(t1, stepper.y()))
+                })),
+            };
+            end_margins.push(c.margin_of_value(value));
+        }
         let terms = match (stepper.end_drift(), &o1) {
             (Some(terms), _) => terms,
             (None, Some(o)) => inv.terms(&o.invariants()),
@@ -385,15 +404,13 @@ impl<'a> Monitor<'a> {
         // and re-crosses within one long step is not missed.
         // (event time, time known, condition, terminal)
         let mut found: Vec<(f64, f64, &Condition, bool)> = Vec::new();
-        if let Some(o1) = &o1 {
+        if !watches.is_empty() {
             // Interior points only where a margin could cross and re-cross inside the step
             // (`far_from_crossing`): elsewhere the step's ends decide, and the dense output
             // is not needed.
             let h = t1 - t0;
             let mut near = false;
             let n_watches = watches.len();
-            end_margins.clear();
-            end_margins.extend(watches.iter().map(|w| w.condition.margin(o1)));
             for (((watch, g_before), &ga), &gb) in watches
                 .iter()
                 .zip(margins_before.iter_mut())
@@ -488,6 +505,17 @@ impl<'a> Monitor<'a> {
             match (sample_due, next_event_t) {
                 (true, Some(te)) if te < tk => {}
                 (true, _) => {
+                    // A sink that reads only the nutation angle takes it as the stepper hands
+                    // it, without an observation.
+                    if let Some(angle) = stepper.nutation_at(tk)
+                        && let Some(taken) = sink.nutation_sample(tk, angle)
+                    {
+                        taken?;
+                        *samples += 1;
+                        *next_k += 1;
+                        *last_sample_t = tk;
+                        continue;
+                    }
                     let o = if tk == t1 {
                         buf.copy_from_slice(stepper.y());
                         match &o1 {
@@ -496,7 +524,9 @@ impl<'a> Monitor<'a> {
                                 angles_to_principal: sc.angles_to_principal(&o.omega),
                                 ..o.clone()
                             },
-                            None => sc.observe_for_events(t1, buf, sample_angles),
+                            None => stepper
+                                .end_observation(sc, sample_angles)
+                                .unwrap_or_else(|| sc.observe_for_events(t1, buf, sample_angles)),
                         }
                     } else if let Some(o) = stepper.observe_at(tk, sc, sample_angles, buf) {
                         o
