@@ -9,8 +9,8 @@
 //! exact operations on the binary exponent), so a lane's result is bit for bit the result at
 //! `f64`: the scalar path calls the same functions and the two paths still agree to the bit.
 //! They are not the platform's functions and may differ from them in the last place:
-//! `half_plane_atan2` by at most one unit in the last place from the correctly rounded
-//! arctangent, `positive_powf` by two where the step-size control calls it
+//! `half_plane_atan2` by at most one unit in the last place from the platform's `atan2`
+//! (glibc's), `positive_powf` by two where the step-size control calls it
 //! (docs/montecarlo.md, "Elementary functions in the lanes", gives the bounds and the tests).
 //!
 //! Both are series with exact coefficients after an argument reduction: the arctangent's
@@ -100,7 +100,8 @@ fn odd_series_tail<L: Lane>(s: L, terms: usize, alternating: bool) -> L {
 }
 
 /// The angle (rad, in [0, π]) of the point (x, y) of the upper half-plane, y ≥ 0:
-/// `y.atan2(x)` for such points, within one unit in the last place of the exact angle.
+/// `y.atan2(x)` for such points, within one unit in the last place of glibc's `atan2`
+/// (tested; the quotient's rounding is corrected and the sum rounded once).
 /// `half_plane_atan2(|a × b|, a · b)` is the angle between a and b. NaN gives NaN;
 /// (0, 0) gives 0 whatever the sign of its zero (`atan2` gives π for (+0, −0)).
 #[inline(always)]
@@ -235,8 +236,7 @@ mod tests {
         (*state >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    /// Against the platform's `atan2` (correctly rounded in glibc's implementation, and
-    /// within one unit in the last place elsewhere): at most one unit apart on a million
+    /// Against the platform's `atan2` (glibc's): at most one unit apart on a million
     /// points of the upper half-plane spread over 40 decades of ratio, both signs of x, and
     /// the points where the reduction changes.
     #[test]
