@@ -151,7 +151,7 @@ pub struct LaneSample {
 
 /// What the run monitor observes of a lane's state, computed in the lanes with the operations
 /// of `Spacecraft::observe` for this class, so that each value is bit for bit the scalar
-/// observation's (the nutation angle and the rest are formed from these per lane). `T` is one
+/// observation's (the rest of the observation is formed from these per lane). `T` is one
 /// value ([`f64`]) or one per lane.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LaneObservation<T = f64> {
@@ -510,8 +510,8 @@ impl<L: Lane> System<L> {
     /// `(x + y) + z`, its 4-vector norm `(i² + k²) + (j² + w²)` and its rotation
     /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
     /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0). Then
-    /// |H| (as `Observation::from_invariants` takes it) and the nutation angle's two
-    /// arguments (its arctangent stays per lane: the platform's `atan2`).
+    /// |H| and the nutation angle (as `Observation::from_invariants` takes them; the
+    /// arctangent is [`half_plane_atan2`], the scalar path's too).
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
         use linalg::cross;

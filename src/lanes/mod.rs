@@ -95,7 +95,8 @@ pub trait Lane:
     /// `f64::clamp(lo, hi)` per lane (`lo` ≤ `hi`; NaN stays NaN).
     fn clamp(self, lo: f64, hi: f64) -> Self;
     /// `f64::powf(e)` per lane: the platform's `pow`, one lane at a time (not vectorised, so
-    /// that the bits are those of the scalar call).
+    /// that the bits are those of the scalar call). For the rare call (dopri5's initial step);
+    /// the step-size control uses [`elementary::positive_powf`].
     fn powf(self, e: f64) -> Self;
     /// For x > 0 finite (subnormals included): the mantissa m in [1, 2) and the exponent k
     /// (an integer, as f64) with x = m·2^k exactly. Unspecified, but no fault, elsewhere.

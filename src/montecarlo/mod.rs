@@ -1000,20 +1000,26 @@ struct Extremes {
     max_nutation: f64,
 }
 
+impl Extremes {
+    fn keep(&mut self, nutation_angle: f64) {
+        self.max_nutation = self.max_nutation.max(nutation_angle);
+    }
+}
+
 impl Sink for Extremes {
     fn sample(&mut self, o: &Observation, _: &[f64], _: &Reference) -> std::io::Result<()> {
-        self.max_nutation = self.max_nutation.max(o.nutation_angle);
+        self.keep(o.nutation_angle);
         Ok(())
     }
     fn event(&mut self, _: &EventRecord, o: &Observation) -> std::io::Result<()> {
-        self.max_nutation = self.max_nutation.max(o.nutation_angle);
+        self.keep(o.nutation_angle);
         Ok(())
     }
     fn reads_principal_angles(&self) -> bool {
         false
     }
     fn nutation_sample(&mut self, _t: f64, nutation_angle: f64) -> Option<std::io::Result<()>> {
-        self.max_nutation = self.max_nutation.max(nutation_angle);
+        self.keep(nutation_angle);
         Some(Ok(()))
     }
 }
