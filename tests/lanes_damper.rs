@@ -199,12 +199,31 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
         // Per run: grid times handed inside steps, at step ends, and left over.
         let mut counts = vec![(0u64, 0u64, 0u64); runs.len()];
         let mut buf = [0.0; 10];
-        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step, dense| {
+        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step, rest| {
             let sc = &craft[k];
             let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
-            assert_observed_as_scalar(sc, step.t, &step.y, &step.end, &what);
+            let mut y = [0.0; 10];
+            rest.state(&mut y);
+            assert_eq!(step.finite, y.iter().all(|v| v.is_finite()), "{what}");
+            let end = rest.end();
+            assert_observed_as_scalar(sc, step.t, &y, &end, &what);
+            // The numbers handed at every step are those of the end observation.
+            for (name, a, b) in [
+                (
+                    "nutation angle",
+                    step.end_nutation_angle,
+                    end.nutation_angle,
+                ),
+                (
+                    "kinetic energy",
+                    step.end_kinetic_energy,
+                    end.kinetic_energy,
+                ),
+            ] {
+                assert_eq!(a.to_bits(), b.to_bits(), "{what}: handed {name}");
+            }
             // The drift terms, as the monitor computes them from the scalar observation.
-            let terms = references[k].terms(&sc.observe(step.t, &step.y).invariants());
+            let terms = references[k].terms(&sc.observe(step.t, &y).invariants());
             for (name, a, b) in [
                 ("|H|", step.drift.h_norm_rel, terms.h_norm_rel),
                 ("H_N", step.drift.h_inertial_rel, terms.h_inertial_rel),
@@ -225,12 +244,19 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
                 .take_while(|&tk| tk <= step.t)
                 .collect();
             let inside: Vec<f64> = grid.iter().copied().filter(|&tk| tk < step.t).collect();
-            match (&step.sample, inside.first()) {
+            match (rest.sample(), inside.first()) {
                 (Some(s), Some(&tk)) => {
                     assert_eq!(s.t.to_bits(), tk.to_bits(), "{what}: sample time");
+                    let handed = step.sample.expect("the grid time is handed");
+                    assert_eq!(handed.t.to_bits(), tk.to_bits(), "{what}: handed time");
+                    assert_eq!(
+                        handed.nutation_angle.to_bits(),
+                        s.observation.nutation_angle.to_bits(),
+                        "{what}: handed nutation angle"
+                    );
                     let mut cont = [[0.0; 10]; 5];
-                    dense.coefficients(&mut cont);
-                    step.interpolate(&cont, tk, &mut buf);
+                    rest.coefficients(&mut cont);
+                    step.interpolate(&y, &cont, tk, &mut buf);
                     for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
                         assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
                     }
@@ -238,7 +264,7 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
                     counts[k].0 += 1;
                     counts[k].2 += inside.len() as u64 - 1;
                 }
-                (None, None) => {}
+                (None, None) => assert!(step.sample.is_none(), "{what}: a grid time handed"),
                 (s, tk) => panic!("{what}: sample {s:?} for the grid time {tk:?}"),
             }
             counts[k].1 += (grid.len() - inside.len()) as u64;

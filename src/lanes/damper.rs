@@ -116,25 +116,40 @@ pub enum LaneStatus {
 }
 
 /// An accepted step of one lane, as [`integrate_runs_observed`] hands it to its observer: the
-/// step's ends, its work and its observations (its dense output comes beside it, as a
-/// [`DenseOutput`]).
+/// few numbers a run monitor reads at every step (the step's ends, its work, its drift, the
+/// nutation angle at its end and at its first grid time). The rest (the state, the whole
+/// observations, the dense output) stays in the lanes, read out for that lane only when asked
+/// ([`StepInLanes`]).
 #[derive(Debug, Clone, Default)]
 pub struct LaneStep {
     /// Start of the step (s).
     pub t_prev: f64,
     /// End of the step (s).
     pub t: f64,
-    /// State at the end of the step (layout of [`DIM`]).
-    pub y: [f64; DIM],
+    /// Whether every component of the state at the end of the step is finite.
+    pub finite: bool,
     /// Work so far: accepted and rejected steps, right-hand-side evaluations.
     pub stats: Stats,
-    /// The observation at the end of the step (of an observed integration).
-    pub end: LaneObservation,
+    /// The nutation angle (rad) of the observation at the end of the step (of an observed
+    /// integration).
+    pub end_nutation_angle: f64,
+    /// The kinetic energy (J) of that observation.
+    pub end_kinetic_energy: f64,
     /// The run's drift at the end of the step from its start (of an observed integration).
     pub drift: LaneDrift,
     /// The first time of the run's output grid strictly inside the step, if there is one, with
-    /// the state there and its observation (of an observed integration).
-    pub sample: Option<LaneSample>,
+    /// the nutation angle there (of an observed integration; the state and the whole
+    /// observation there: [`StepInLanes::sample`]).
+    pub sample: Option<GridAngle>,
+}
+
+/// A time of a run's output grid and the nutation angle there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridAngle {
+    /// The grid time (s): k / `sample_rate`.
+    pub t: f64,
+    /// The nutation angle there (rad).
+    pub nutation_angle: f64,
 }
 
 /// The state at one time of the output grid inside a step, from the step's dense output (as
@@ -184,13 +199,13 @@ impl<L: Lane> LaneObservation<L> {
     #[inline(always)]
     fn lane(&self, i: usize) -> LaneObservation {
         let mut o = LaneObservation {
-            q_norm_error: self.q_norm_error.lane(i),
-            kinetic_energy: self.kinetic_energy.lane(i),
-            elastic_energy: self.elastic_energy.lane(i),
-            dissipated_energy: self.dissipated_energy.lane(i),
-            dissipation_power: self.dissipation_power.lane(i),
-            h_norm: self.h_norm.lane(i),
-            nutation_angle: self.nutation_angle.lane(i),
+            q_norm_error: read(&self.q_norm_error, i),
+            kinetic_energy: read(&self.kinetic_energy, i),
+            elastic_energy: read(&self.elastic_energy, i),
+            dissipated_energy: read(&self.dissipated_energy, i),
+            dissipation_power: read(&self.dissipation_power, i),
+            h_norm: read(&self.h_norm, i),
+            nutation_angle: read(&self.nutation_angle, i),
             ..LaneObservation::default()
         };
         L::gather_lane(&self.attitude, i, &mut o.attitude);
@@ -223,10 +238,10 @@ impl<L: Lane> LaneDrift<L> {
     #[inline(always)]
     fn lane(&self, i: usize) -> LaneDrift {
         LaneDrift {
-            h_norm_rel: self.h_norm_rel.lane(i),
-            h_inertial_rel: self.h_inertial_rel.lane(i),
-            energy_rel: self.energy_rel.lane(i),
-            q_norm: self.q_norm.lane(i),
+            h_norm_rel: read(&self.h_norm_rel, i),
+            h_inertial_rel: read(&self.h_inertial_rel, i),
+            energy_rel: read(&self.energy_rel, i),
+            q_norm: read(&self.q_norm, i),
         }
     }
 }
@@ -286,44 +301,111 @@ impl<L: Lane> LaneObservation<L> {
     }
 }
 
-/// The dense output of the step a lane has just accepted, still in the lanes: gathered out
-/// of them for that lane only when asked, since the observer rarely interpolates (the lanes
-/// hand it the step's end and its first grid sample already observed).
-pub trait DenseOutput {
+/// The rest of the step a lane has just accepted ([`LaneStep`]), still in the lanes: read out
+/// of them for that lane only when asked, since a run monitor rarely needs more than the
+/// step hands it (copying it all out at every step cost a tenth of a campaign).
+pub trait StepInLanes {
+    /// The state at the end of the step (layout of [`DIM`]), into `out`.
+    fn state(&self, out: &mut [f64; DIM]);
+    /// The observation at the end of the step (of an observed integration).
+    fn end(&self) -> LaneObservation;
+    /// The step's first grid time strictly inside it, if there is one, with the state there
+    /// and its observation (of an observed integration).
+    fn sample(&self) -> Option<LaneSample>;
     /// The step's dense-output coefficients (those of the scalar `Dopri5`), into `out`.
     fn coefficients(&self, out: &mut [[f64; DIM]; 5]);
 }
 
-/// Lane `lane`'s dense output in the lanes' coefficients.
-struct LaneDense<'a, L: Lane> {
-    cont: &'a [[L; DIM]; 5],
+/// Lane `i` of `value`, read where it lies (a method called outside the engine's compiled
+/// instruction set may not hold the lane type in a register).
+#[inline(always)]
+fn read<L: Lane>(value: &L, i: usize) -> f64 {
+    let mut x = [0.0];
+    L::gather_lane(std::slice::from_ref(value), i, &mut x);
+    x[0]
+}
+
+/// Lane `lane`'s step in the lanes.
+struct LaneRest<'a, L: Lane> {
+    lanes: &'a Lanes<L>,
     lane: usize,
 }
 
-impl<L: Lane> DenseOutput for LaneDense<'_, L> {
+impl<L: Lane> StepInLanes for LaneRest<'_, L> {
+    fn state(&self, out: &mut [f64; DIM]) {
+        L::gather_lane(&self.lanes.y, self.lane, out);
+    }
+    fn end(&self) -> LaneObservation {
+        self.lanes
+            .end
+            .as_ref()
+            .map_or_else(LaneObservation::default, |e| e.lane(self.lane))
+    }
+    fn sample(&self) -> Option<LaneSample> {
+        let i = self.lane;
+        match &self.lanes.sample {
+            Some(SampleLanes {
+                due,
+                t,
+                y,
+                observation,
+            }) if due.test(i) => {
+                let mut sample = LaneSample {
+                    t: read(t, i),
+                    y: [0.0; DIM],
+                    observation: observation.lane(i),
+                };
+                L::gather_lane(y, i, &mut sample.y);
+                Some(sample)
+            }
+            _ => None,
+        }
+    }
     fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
-        for (out, cont) in out.iter_mut().zip(self.cont) {
+        for (out, cont) in out.iter_mut().zip(&self.lanes.cont) {
             L::gather_lane(cont, self.lane, out);
         }
     }
 }
 
+/// A run's state where it stands, with no step in the lanes: at its start, or at its end
+/// ([`LaneStep::at_end`]). There is nothing to interpolate in (`t_prev = t`).
+#[derive(Debug, Clone)]
+pub struct Settled(pub [f64; DIM]);
+
+impl StepInLanes for Settled {
+    fn state(&self, out: &mut [f64; DIM]) {
+        *out = self.0;
+    }
+    fn end(&self) -> LaneObservation {
+        LaneObservation::default()
+    }
+    fn sample(&self) -> Option<LaneSample> {
+        None
+    }
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
+        *out = [[0.0; DIM]; 5];
+    }
+}
+
 impl LaneStep {
-    /// The state at `t` (s) in the step, from its dense-output coefficients `cont`
-    /// ([`DenseOutput::coefficients`]), as the scalar `Dopri5` interpolates.
-    pub fn interpolate(&self, cont: &[[f64; DIM]; 5], t: f64, out: &mut [f64]) {
-        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, &self.y, cont, out);
+    /// The state at `t` (s) in the step, from its end state `y` ([`StepInLanes::state`]) and
+    /// its dense-output coefficients `cont` ([`StepInLanes::coefficients`]), as the scalar
+    /// `Dopri5` interpolates.
+    pub fn interpolate(&self, y: &[f64; DIM], cont: &[[f64; DIM]; 5], t: f64, out: &mut [f64]) {
+        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, y, cont, out);
     }
 
-    /// The step view of a run's end (`outcome`): its state, with no step to interpolate in.
-    pub fn at_end(outcome: &LaneOutcome) -> Self {
-        LaneStep {
+    /// The step view of a run's end (`outcome`), with its state: no step to interpolate in.
+    pub fn at_end(outcome: &LaneOutcome) -> (Self, Settled) {
+        let step = LaneStep {
             t_prev: outcome.t,
             t: outcome.t,
-            y: outcome.y,
+            finite: outcome.y.iter().all(|v| v.is_finite()),
             stats: outcome.stats,
             ..LaneStep::default()
-        }
+        };
+        (step, Settled(outcome.y))
     }
 }
 
@@ -341,8 +423,9 @@ pub struct LaneOutcome {
 }
 
 /// What [`integrate_runs_observed`] calls after each accepted step of a run: `(run, step,
-/// dense)`, the run's index, its step and the step's dense output; false ends the run there.
-pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep, &dyn DenseOutput) -> bool;
+/// rest)`, the run's index, its step and the rest of the step in the lanes; false ends the
+/// run there.
+pub type Observer<'o> = &'o mut dyn FnMut(usize, &LaneStep, &dyn StepInLanes) -> bool;
 
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -748,14 +831,16 @@ impl<L: Lane> Lanes<L> {
         }
     }
 
-    /// Lane `i`'s last accepted step (of an observed integration), into `step`.
+    /// Lane `i`'s last accepted step (of an observed integration), into `step`: the numbers
+    /// read at every step, the rest left in the lanes ([`LaneRest`]).
     #[inline(always)]
     fn step_of(&self, i: usize, step: &mut LaneStep) {
-        step.t_prev = self.t_prev.lane(i);
-        step.t = self.t.lane(i);
-        L::gather_lane(&self.y, i, &mut step.y);
+        step.t_prev = read(&self.t_prev, i);
+        step.t = read(&self.t, i);
+        step.finite = self.y.iter().all(|y| read(y, i).is_finite());
         if let Some(e) = &self.end {
-            step.end = e.lane(i);
+            step.end_nutation_angle = read(&e.nutation_angle, i);
+            step.end_kinetic_energy = read(&e.kinetic_energy, i);
         }
         if let Some(d) = &self.drift {
             step.drift = d.lane(i);
@@ -764,23 +849,18 @@ impl<L: Lane> Lanes<L> {
             Some(SampleLanes {
                 due,
                 t,
-                y,
                 observation,
-            }) if due.test(i) => {
-                let mut sample = LaneSample {
-                    t: t.lane(i),
-                    y: [0.0; DIM],
-                    observation: observation.lane(i),
-                };
-                L::gather_lane(y, i, &mut sample.y);
-                Some(sample)
-            }
+                ..
+            }) if due.test(i) => Some(GridAngle {
+                t: read(t, i),
+                nutation_angle: read(&observation.nutation_angle, i),
+            }),
             _ => None,
         };
         step.stats = Stats {
-            steps: self.steps.lane(i) as u64,
-            rejected_steps: self.rejected.lane(i) as u64,
-            rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
+            steps: read(&self.steps, i) as u64,
+            rejected_steps: read(&self.rejected, i) as u64,
+            rhs_evaluations: read(&self.rhs_evaluations, i) as u64,
             ..Stats::default()
         };
     }
@@ -1079,11 +1159,11 @@ fn lockstep<L: Lane>(
                         && accepted.test(i)
                     {
                         lanes.step_of(i, &mut step);
-                        let dense = LaneDense {
-                            cont: &lanes.cont,
+                        let rest = LaneRest {
+                            lanes: &lanes,
                             lane: i,
                         };
-                        if !observe(index, &step, &dense) {
+                        if !observe(index, &step, &rest) {
                             lanes.end_observed(i);
                         }
                     }

@@ -56,6 +56,14 @@ fn numeric(token: &str) -> Option<f64> {
     token.replace('_', "").parse::<f64>().ok()
 }
 
+/// The smallest bound of any key: a number within it is within its own.
+fn smallest_bound() -> f64 {
+    BOUNDS
+        .iter()
+        .filter_map(|b| b.1)
+        .fold(MAX_MAGNITUDE, f64::min)
+}
+
 /// Checks every number of `source` against its bound; the first one out of bounds is an error
 /// naming its line, column and field.
 pub(super) fn check(path: &Path, source: &str) -> Result<(), ScenarioError> {
@@ -100,7 +108,12 @@ pub(super) fn check(path: &Path, source: &str) -> Result<(), ScenarioError> {
                     let token: String = chars[s..k].iter().collect();
                     // A key is followed by ':' (then a space or the end); skip it.
                     let is_key = c == ':';
-                    if !is_key && let Some(v) = numeric(&token) {
+                    // A number within the smallest bound breaches none: its field (a
+                    // search of the text) is looked up only for the others.
+                    if !is_key
+                        && let Some(v) = numeric(&token)
+                        && v.abs() > smallest_bound()
+                    {
                         let column = s as u32 + 1;
                         let field = field_path_at(source, line, column);
                         let key = field.rsplit('.').next().unwrap_or("");

@@ -15,8 +15,8 @@ use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
-    DIM, DamperRun, DenseOutput, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep,
-    integrate_runs_observed_with,
+    DIM, DamperRun, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep, Settled,
+    StepInLanes, integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -24,31 +24,31 @@ use std::any::Any;
 use std::cell::OnceCell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A lane's step as the monitor reads it, with its dense output, gathered out of the lanes
-/// the first time the monitor interpolates in the step.
+/// A lane's step as the monitor reads it: the state at its end and its dense output are
+/// read out of the lanes the first time the monitor asks for them.
 struct LaneView<'s> {
     step: &'s LaneStep,
-    dense: &'s dyn DenseOutput,
+    rest: &'s dyn StepInLanes,
+    y: OnceCell<[f64; DIM]>,
     cont: OnceCell<[[f64; DIM]; 5]>,
 }
 
 impl<'s> LaneView<'s> {
-    fn new(step: &'s LaneStep, dense: &'s dyn DenseOutput) -> Self {
+    fn new(step: &'s LaneStep, rest: &'s dyn StepInLanes) -> Self {
         LaneView {
             step,
-            dense,
+            rest,
+            y: OnceCell::new(),
             cont: OnceCell::new(),
         }
     }
-}
 
-/// The dense output of a run's end, where there is no step to interpolate in (`t_prev = t`:
-/// the interpolation is the state there).
-struct NoStep;
-
-impl DenseOutput for NoStep {
-    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
-        *out = [[0.0; DIM]; 5];
+    fn state(&self) -> &[f64; DIM] {
+        self.y.get_or_init(|| {
+            let mut y = [0.0; DIM];
+            self.rest.state(&mut y);
+            y
+        })
     }
 }
 
@@ -60,15 +60,18 @@ impl StepView for LaneView<'_> {
         self.step.t_prev
     }
     fn y(&self) -> &[f64] {
-        &self.step.y
+        self.state()
+    }
+    fn state_is_finite(&self) -> bool {
+        self.step.finite
     }
     fn interpolate(&self, t: f64, out: &mut [f64]) {
         let cont = self.cont.get_or_init(|| {
             let mut cont = [[0.0; DIM]; 5];
-            self.dense.coefficients(&mut cont);
+            self.rest.coefficients(&mut cont);
             cont
         });
-        self.step.interpolate(cont, t, out);
+        self.step.interpolate(self.state(), cont, t, out);
     }
     fn prepare_interpolation(&mut self, _: &Spacecraft) -> bool {
         true
@@ -89,24 +92,24 @@ impl StepView for LaneView<'_> {
     /// from the observation formed of them (`observation`): ω from the state, the kinetic
     /// energy and the nutation angle from the lanes' observation.
     fn end_value(&self, quantity: Quantity) -> Option<f64> {
-        let end = &self.step.end;
+        let step = self.step;
         match quantity {
-            Quantity::NutationAngleDeg => Some(end.nutation_angle.to_degrees()),
-            Quantity::Omega(i) => Some(self.step.y[i]),
-            Quantity::KineticEnergy => Some(end.kinetic_energy),
+            Quantity::NutationAngleDeg => Some(step.end_nutation_angle.to_degrees()),
+            Quantity::Omega(i) => Some(self.state()[i]),
+            Quantity::KineticEnergy => Some(step.end_kinetic_energy),
             _ => None,
         }
     }
     fn nutation_at(&self, t: f64) -> Option<f64> {
         if t.to_bits() == self.step.t.to_bits() {
-            return Some(self.step.end.nutation_angle);
+            return Some(self.step.end_nutation_angle);
         }
         let sample = self.step.sample.as_ref()?;
-        (sample.t.to_bits() == t.to_bits()).then_some(sample.observation.nutation_angle)
+        (sample.t.to_bits() == t.to_bits()).then_some(sample.nutation_angle)
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
-        let step = self.step;
-        Some(observation(sc, step.t, &step.y, &step.end, angles))
+        let (step, y) = (self.step, self.state());
+        Some(observation(sc, step.t, y, &self.rest.end(), angles))
     }
     fn observe_at(
         &self,
@@ -115,10 +118,10 @@ impl StepView for LaneView<'_> {
         angles: bool,
         out: &mut [f64],
     ) -> Option<Observation> {
-        let sample = self.step.sample.as_ref()?;
-        if sample.t.to_bits() != t.to_bits() {
+        if self.step.sample?.t.to_bits() != t.to_bits() {
             return None;
         }
+        let sample = self.rest.sample()?;
         out.copy_from_slice(&sample.y);
         Some(observation(sc, t, &sample.y, &sample.observation, angles))
     }
@@ -272,10 +275,11 @@ pub fn run_in_lanes<S: Sink + Default>(
         if status.is_some() || !steps_ahead {
             // Ended at t = 0, as the scalar loop does without a step.
             let start = LaneStep {
-                y: y0,
+                finite: y0.iter().all(|v| v.is_finite()),
                 ..LaneStep::default()
             };
-            let outcome = monitor.finish(&LaneView::new(&start, &NoStep), status, &mut sink)?;
+            let outcome =
+                monitor.finish(&LaneView::new(&start, &Settled(y0)), status, &mut sink)?;
             results[index] = Some((outcome, sink));
             continue;
         }
@@ -291,7 +295,7 @@ pub fn run_in_lanes<S: Sink + Default>(
         return Ok(results);
     };
     let mut io_error = None;
-    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step, dense| {
+    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step, rest| {
         let w = &mut watched[k];
         if interrupt.load(Ordering::Relaxed) {
             w.status = Some(Status::Interrupted);
@@ -299,7 +303,7 @@ pub fn run_in_lanes<S: Sink + Default>(
         }
         match w
             .monitor
-            .after_step(&mut LaneView::new(step, dense), &mut w.sink)
+            .after_step(&mut LaneView::new(step, rest), &mut w.sink)
         {
             Ok(None) => true,
             Ok(Some(status)) => {
@@ -326,10 +330,10 @@ pub fn run_in_lanes<S: Sink + Default>(
             }),
         };
         let mut sink = w.sink;
-        let end = LaneStep::at_end(&outcome);
+        let (end, state) = LaneStep::at_end(&outcome);
         let result = w
             .monitor
-            .finish(&LaneView::new(&end, &NoStep), status, &mut sink)?;
+            .finish(&LaneView::new(&end, &state), status, &mut sink)?;
         results[w.index] = Some((result, sink));
     }
     Ok(results)

@@ -23,6 +23,10 @@ pub(crate) trait StepView {
     fn t_prev(&self) -> f64;
     /// State at the end of the step.
     fn y(&self) -> &[f64];
+    /// Whether every component of the state at the end of the step is finite.
+    fn state_is_finite(&self) -> bool {
+        self.y().iter().all(|v| v.is_finite())
+    }
     /// The state at `t` in the step, from its dense output.
     fn interpolate(&self, t: f64, out: &mut [f64]);
     /// Makes the dense output inside the step available; false if it came out non-finite.
@@ -304,7 +308,7 @@ impl<'a> Monitor<'a> {
         let observe_for_events = |t: f64, y: &[f64]| sc.observe_for_events(t, y, watched_angles);
         let t0 = stepper.t_prev();
         let t1 = stepper.t();
-        if !stepper.y().iter().all(|v| v.is_finite()) {
+        if !stepper.state_is_finite() {
             // Report the last finite state: the start of the failed step.
             let t_good = stepper.t_prev();
             stepper.interpolate(t_good, buf);
