@@ -16,8 +16,8 @@ use polhode::effectors::particles::ParticleEffector;
 use polhode::effectors::spring_mass::SpringMass;
 use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
 use polhode::lanes::damper::{
-    DamperRun, Engine, LaneObservation, LaneOutcome, LaneSettings, LaneStatus, integrate_runs,
-    integrate_runs_observed_with, integrate_runs_with,
+    DamperRun, Engine, GridObservation, LaneObservation, LaneOutcome, LaneSettings, LaneStatus,
+    integrate_runs, integrate_runs_observed_with, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
 use polhode::sim::Reference;
@@ -199,77 +199,83 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
         // Per run: grid times handed inside steps, at step ends, and left over.
         let mut counts = vec![(0u64, 0u64, 0u64); runs.len()];
         let mut buf = [0.0; 10];
-        integrate_runs_observed_with(engine, &runs, &SETTINGS, &mut |k, step, rest| {
-            let sc = &craft[k];
-            let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
-            let mut y = [0.0; 10];
-            rest.state(&mut y);
-            assert_eq!(step.finite, y.iter().all(|v| v.is_finite()), "{what}");
-            let end = rest.end();
-            assert_observed_as_scalar(sc, step.t, &y, &end, &what);
-            // The numbers handed at every step are those of the end observation.
-            for (name, a, b) in [
-                (
-                    "nutation angle",
-                    step.end_nutation_angle,
-                    end.nutation_angle,
-                ),
-                (
-                    "kinetic energy",
-                    step.end_kinetic_energy,
-                    end.kinetic_energy,
-                ),
-            ] {
-                assert_eq!(a.to_bits(), b.to_bits(), "{what}: handed {name}");
-            }
-            // The drift terms, as the monitor computes them from the scalar observation.
-            let terms = references[k].terms(&sc.observe(step.t, &y).invariants());
-            for (name, a, b) in [
-                ("|H|", step.drift.h_norm_rel, terms.h_norm_rel),
-                ("H_N", step.drift.h_inertial_rel, terms.h_inertial_rel),
-                ("energy", step.drift.energy_rel, terms.energy_rel),
-                ("|q|", step.drift.q_norm, terms.q_norm),
-            ] {
-                assert_eq!(
-                    a.to_bits(),
-                    b.to_bits(),
-                    "{what}: {name} drift {a:e} vs {b:e}"
-                );
-            }
-            // The grid times in (t_prev, t].
-            let first = (step.t_prev * rate).floor() as u64 + 1;
-            let grid: Vec<f64> = (first..)
-                .map(|j| j as f64 / rate)
-                .skip_while(|&tk| tk <= step.t_prev)
-                .take_while(|&tk| tk <= step.t)
-                .collect();
-            let inside: Vec<f64> = grid.iter().copied().filter(|&tk| tk < step.t).collect();
-            match (rest.sample(), inside.first()) {
-                (Some(s), Some(&tk)) => {
-                    assert_eq!(s.t.to_bits(), tk.to_bits(), "{what}: sample time");
-                    let handed = step.sample.expect("the grid time is handed");
-                    assert_eq!(handed.t.to_bits(), tk.to_bits(), "{what}: handed time");
-                    assert_eq!(
-                        handed.nutation_angle.to_bits(),
-                        s.observation.nutation_angle.to_bits(),
-                        "{what}: handed nutation angle"
-                    );
-                    let mut cont = [[0.0; 10]; 5];
-                    rest.coefficients(&mut cont);
-                    step.interpolate(&y, &cont, tk, &mut buf);
-                    for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
-                        assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
-                    }
-                    assert_observed_as_scalar(sc, tk, &s.y, &s.observation, &what);
-                    counts[k].0 += 1;
-                    counts[k].2 += inside.len() as u64 - 1;
+        integrate_runs_observed_with(
+            engine,
+            &runs,
+            &SETTINGS,
+            GridObservation::Full,
+            &mut |k, step, rest| {
+                let sc = &craft[k];
+                let what = format!("{engine:?}, run {k}, step to t = {}", step.t);
+                let mut y = [0.0; 10];
+                rest.state(&mut y);
+                assert_eq!(step.finite, y.iter().all(|v| v.is_finite()), "{what}");
+                let end = rest.end();
+                assert_observed_as_scalar(sc, step.t, &y, &end, &what);
+                // The numbers handed at every step are those of the end observation.
+                for (name, a, b) in [
+                    (
+                        "nutation angle",
+                        step.end_nutation_angle,
+                        end.nutation_angle,
+                    ),
+                    (
+                        "kinetic energy",
+                        step.end_kinetic_energy,
+                        end.kinetic_energy,
+                    ),
+                ] {
+                    assert_eq!(a.to_bits(), b.to_bits(), "{what}: handed {name}");
                 }
-                (None, None) => assert!(step.sample.is_none(), "{what}: a grid time handed"),
-                (s, tk) => panic!("{what}: sample {s:?} for the grid time {tk:?}"),
-            }
-            counts[k].1 += (grid.len() - inside.len()) as u64;
-            true
-        });
+                // The drift terms, as the monitor computes them from the scalar observation.
+                let terms = references[k].terms(&sc.observe(step.t, &y).invariants());
+                for (name, a, b) in [
+                    ("|H|", step.drift.h_norm_rel, terms.h_norm_rel),
+                    ("H_N", step.drift.h_inertial_rel, terms.h_inertial_rel),
+                    ("energy", step.drift.energy_rel, terms.energy_rel),
+                    ("|q|", step.drift.q_norm, terms.q_norm),
+                ] {
+                    assert_eq!(
+                        a.to_bits(),
+                        b.to_bits(),
+                        "{what}: {name} drift {a:e} vs {b:e}"
+                    );
+                }
+                // The grid times in (t_prev, t].
+                let first = (step.t_prev * rate).floor() as u64 + 1;
+                let grid: Vec<f64> = (first..)
+                    .map(|j| j as f64 / rate)
+                    .skip_while(|&tk| tk <= step.t_prev)
+                    .take_while(|&tk| tk <= step.t)
+                    .collect();
+                let inside: Vec<f64> = grid.iter().copied().filter(|&tk| tk < step.t).collect();
+                match (rest.sample(), inside.first()) {
+                    (Some(s), Some(&tk)) => {
+                        assert_eq!(s.t.to_bits(), tk.to_bits(), "{what}: sample time");
+                        let handed = step.sample.expect("the grid time is handed");
+                        assert_eq!(handed.t.to_bits(), tk.to_bits(), "{what}: handed time");
+                        assert_eq!(
+                            handed.nutation_angle.to_bits(),
+                            s.observation.nutation_angle.to_bits(),
+                            "{what}: handed nutation angle"
+                        );
+                        let mut cont = [[0.0; 10]; 5];
+                        rest.coefficients(&mut cont);
+                        step.interpolate(&y, &cont, tk, &mut buf);
+                        for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
+                            assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
+                        }
+                        assert_observed_as_scalar(sc, tk, &s.y, &s.observation, &what);
+                        counts[k].0 += 1;
+                        counts[k].2 += inside.len() as u64 - 1;
+                    }
+                    (None, None) => assert!(step.sample.is_none(), "{what}: a grid time handed"),
+                    (s, tk) => panic!("{what}: sample {s:?} for the grid time {tk:?}"),
+                }
+                counts[k].1 += (grid.len() - inside.len()) as u64;
+                true
+            },
+        );
         for (k, (run, &(inside, at_end, left))) in runs.iter().zip(&counts).enumerate() {
             // Every grid time in (0, t_end] is accounted for once.
             let whole = (run.t_end * rate).floor() as u64;
@@ -403,5 +409,34 @@ fn bench_lanes_against_the_scalar_loop() {
             rate(t),
             scalar_loop / t
         );
+    }
+    // What the lanes' observations cost, with an observer that reads nothing: each step's
+    // end observation and drift and its dense output, without and with a grid time inside
+    // it at 20 Hz (as a campaign of scenarios/nutation-damper.yaml asks).
+    for sample_rate in [0.0, 20.0] {
+        let mut sampled = runs.clone();
+        for run in &mut sampled {
+            run.sample_rate = sample_rate;
+        }
+        for engine in engines() {
+            let plain = time(&mut || {
+                std::hint::black_box(integrate_runs_with(engine, &sampled, &SETTINGS));
+            });
+            let observed = time(&mut || {
+                std::hint::black_box(integrate_runs_observed_with(
+                    engine,
+                    &sampled,
+                    &SETTINGS,
+                    GridObservation::NutationAngle,
+                    &mut |_, _, _| true,
+                ));
+            });
+            println!(
+                "  {engine:?} observed, grid at {sample_rate} Hz: {:.1} runs/s, {:.2}x the \
+                 time unobserved",
+                rate(observed),
+                observed / plain
+            );
+        }
     }
 }

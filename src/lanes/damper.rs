@@ -143,6 +143,19 @@ pub struct LaneStep {
     pub sample: Option<GridAngle>,
 }
 
+/// What an observed integration computes at the output grid time inside a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridObservation {
+    /// The state there and its whole observation ([`StepInLanes::sample`]).
+    Full,
+    /// The nutation angle alone ([`LaneStep::sample`]), for an observer that reads nothing
+    /// else there; [`StepInLanes::sample`] is `None`. The operations are [`Full`]'s (the
+    /// compiler drops what the angle does not need), so the angle is the same.
+    ///
+    /// [`Full`]: GridObservation::Full
+    NutationAngle,
+}
+
 /// A time of a run's output grid and the nutation angle there.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridAngle {
@@ -347,8 +360,8 @@ impl<L: Lane> StepInLanes for LaneRest<'_, L> {
             Some(SampleLanes {
                 due,
                 t,
-                y,
-                observation,
+                full: Some((y, observation)),
+                ..
             }) if due.test(i) => {
                 let mut sample = LaneSample {
                     t: read(t, i),
@@ -362,9 +375,18 @@ impl<L: Lane> StepInLanes for LaneRest<'_, L> {
         }
     }
     fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
-        for (out, cont) in out.iter_mut().zip(&self.lanes.cont) {
-            L::gather_lane(cont, self.lane, out);
+        // The scalar `Dopri5`'s arithmetic on this lane's stages (the lanes' arithmetic is
+        // the same, lane by lane).
+        let (lanes, i) = (self.lanes, self.lane);
+        let mut k = [[0.0; DIM]; 7];
+        L::gather_lane(&lanes.k_start, i, &mut k[0]);
+        for (k, stage) in k.iter_mut().zip(&lanes.k).skip(1) {
+            L::gather_lane(stage, i, k);
         }
+        let (mut y_start, mut y_new) = ([0.0; DIM], [0.0; DIM]);
+        L::gather_lane(&lanes.y_start, i, &mut y_start);
+        L::gather_lane(&lanes.y_new, i, &mut y_new);
+        dense_coefficients(read(&lanes.h_step, i), &k, &y_start, &y_new, out);
     }
 }
 
@@ -473,14 +495,15 @@ pub fn integrate_runs_with(
 }
 
 /// [`integrate_runs`], handing every accepted step of every run to `observe(run, step)` (the
-/// run's index in `runs`); when it returns false, the run ends there with
-/// [`LaneStatus::Ended`].
+/// run's index in `runs`), with what `grid` asks at its output grid; when it returns false,
+/// the run ends there with [`LaneStatus::Ended`].
 pub fn integrate_runs_observed(
     runs: &[DamperRun],
     settings: &LaneSettings,
+    grid: GridObservation,
     observe: Observer<'_>,
 ) -> Vec<LaneOutcome> {
-    run_engine(Engine::Auto, runs, settings, Some(observe))
+    run_engine(Engine::Auto, runs, settings, Some((grid, observe)))
 }
 
 /// [`integrate_runs_observed`] with a given engine.
@@ -488,10 +511,14 @@ pub fn integrate_runs_observed_with(
     engine: Engine,
     runs: &[DamperRun],
     settings: &LaneSettings,
+    grid: GridObservation,
     observe: Observer<'_>,
 ) -> Vec<LaneOutcome> {
-    run_engine(engine, runs, settings, Some(observe))
+    run_engine(engine, runs, settings, Some((grid, observe)))
 }
+
+/// An observer and what it reads at the output grid.
+type Observing<'o> = Option<(GridObservation, Observer<'o>)>;
 
 /// The engine actually run for `engine` on this processor.
 pub fn resolved(engine: Engine) -> Engine {
@@ -508,7 +535,7 @@ fn run_engine(
     engine: Engine,
     runs: &[DamperRun],
     settings: &LaneSettings,
-    observe: Option<Observer<'_>>,
+    observe: Observing<'_>,
 ) -> Vec<LaneOutcome> {
     match resolved(engine) {
         Engine::Portable4 => lockstep::<F64x4>(runs, settings, observe),
@@ -534,7 +561,7 @@ fn run_engine(
 unsafe fn lockstep_avx2(
     runs: &[DamperRun],
     settings: &LaneSettings,
-    observe: Option<Observer<'_>>,
+    observe: Observing<'_>,
 ) -> Vec<LaneOutcome> {
     lockstep::<F64x4>(runs, settings, observe)
 }
@@ -547,7 +574,7 @@ unsafe fn lockstep_avx2(
 unsafe fn lockstep_avx512(
     runs: &[DamperRun],
     settings: &LaneSettings,
-    observe: Option<Observer<'_>>,
+    observe: Observing<'_>,
 ) -> Vec<LaneOutcome> {
     lockstep::<super::f64x8::F64x8>(runs, settings, observe)
 }
@@ -669,12 +696,13 @@ impl<L: Lane> StageRhs<L> for Solving<'_, L> {
     }
 }
 
-/// [`LaneSample`] in lanes, for the lanes of `due`.
+/// [`LaneSample`] in lanes, for the lanes of `due`: the nutation angle, and the state and
+/// its whole observation where the grid observation is [`GridObservation::Full`].
 struct SampleLanes<L: Lane> {
     due: L::Mask,
     t: L,
-    y: [L; DIM],
-    observation: LaneObservation<L>,
+    nutation_angle: L,
+    full: Option<([L; DIM], LaneObservation<L>)>,
 }
 
 /// The lanes' integration state: each field holds one value per lane.
@@ -695,8 +723,12 @@ struct Lanes<L: Lane> {
     y_new: [L; DIM],
     stage: [L; DIM],
     k: [[L; DIM]; 7],
-    /// Dense-output coefficients of the last accepted step, when observed.
-    cont: [[L; DIM]; 5],
+    /// The state and the first stage at the start of the last attempted step and its size
+    /// (s), when observed: with the other stages and `y_new`, what its dense output is
+    /// formed of (only where it is read: [`Lanes::sample_inside`], [`LaneRest`]).
+    y_start: [L; DIM],
+    k_start: [L; DIM],
+    h_step: L,
     /// The observation at the end of the last accepted step, when observed, and the drift
     /// there from each run's start.
     end: Option<LaneObservation<L>>,
@@ -718,6 +750,8 @@ struct Lanes<L: Lane> {
     saw_non_finite: L::Mask,
     /// Lanes holding a run that is still stepping.
     running: L::Mask,
+    /// What an observed integration computes at the output grid.
+    grid: GridObservation,
     /// Lanes that ended in the last phase, with their status, to be collected.
     ended: Vec<(usize, LaneStatus)>,
 }
@@ -753,7 +787,9 @@ impl<L: Lane> Lanes<L> {
             y_new: [z; DIM],
             stage: [z; DIM],
             k: [[z; DIM]; 7],
-            cont: [[z; DIM]; 5],
+            y_start: [z; DIM],
+            k_start: [z; DIM],
+            h_step: z,
             end: None,
             drift: None,
             reference: None,
@@ -766,6 +802,7 @@ impl<L: Lane> Lanes<L> {
             rejected_in_a_row: z,
             saw_non_finite: L::Mask::splat(false),
             running: L::Mask::splat(false),
+            grid: GridObservation::Full,
             ended: Vec::with_capacity(L::WIDTH),
         };
         for i in 0..L::WIDTH {
@@ -849,11 +886,11 @@ impl<L: Lane> Lanes<L> {
             Some(SampleLanes {
                 due,
                 t,
-                observation,
+                nutation_angle,
                 ..
             }) if due.test(i) => Some(GridAngle {
                 t: read(t, i),
-                nutation_angle: read(&observation.nutation_angle, i),
+                nutation_angle: read(nutation_angle, i),
             }),
             _ => None,
         };
@@ -974,12 +1011,18 @@ impl<L: Lane> Lanes<L> {
         let due = gridded & t_k.less_than(self.t);
         self.sample = if due.any() {
             let mut y = [zero; DIM];
-            dense_interior(t_k, self.t_prev, self.t, &self.cont, &mut y);
+            // The step's dense output (what the observation does not read of it is dropped).
+            let mut cont = [[zero; DIM]; 5];
+            let [_, k2, k3, k4, k5, k6, k7] = &self.k;
+            let k = [&self.k_start, k2, k3, k4, k5, k6, k7];
+            dense_coefficients(self.h_step, &k, &self.y_start, &self.y_new, &mut cont);
+            dense_interior(t_k, self.t_prev, self.t, &cont, &mut y);
+            let observation = self.system.observe(&y);
             Some(SampleLanes {
                 due,
                 t: t_k,
-                y,
-                observation: self.system.observe(&y),
+                nutation_angle: observation.nutation_angle,
+                full: (self.grid == GridObservation::Full).then_some((y, observation)),
             })
         } else {
             None
@@ -1056,7 +1099,9 @@ impl<L: Lane> Lanes<L> {
         self.fac_old = L::select(accept, fac_old, self.fac_old);
         if observed {
             // For every lane (the others' are not read): the scalar `Dopri5`'s coefficients.
-            dense_coefficients(h, &self.k, &self.y, &self.y_new, &mut self.cont);
+            self.y_start = self.y;
+            self.k_start = self.k[0];
+            self.h_step = h;
             self.t_prev = L::select(accept, self.t, self.t_prev);
         }
         for j in 0..DIM {
@@ -1106,13 +1151,17 @@ impl<L: Lane> Lanes<L> {
 fn lockstep<L: Lane>(
     runs: &[DamperRun],
     settings: &LaneSettings,
-    mut observe: Option<Observer<'_>>,
+    observe: Observing<'_>,
 ) -> Vec<LaneOutcome> {
     let mut outcomes: Vec<Option<LaneOutcome>> = vec![None; runs.len()];
     let Some(first) = runs.first() else {
         return Vec::new();
     };
     let mut lanes = Lanes::<L>::new(first, settings);
+    let mut observe = observe.map(|(grid, observer)| {
+        lanes.grid = grid;
+        observer
+    });
     let mut held: Vec<Option<usize>> = vec![None; L::WIDTH];
     let mut next = 0;
     // The observed lane's step, reused.

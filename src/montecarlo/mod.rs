@@ -1022,6 +1022,9 @@ impl Sink for Extremes {
         self.keep(nutation_angle);
         Some(Ok(()))
     }
+    fn reads_only_nutation(&self) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

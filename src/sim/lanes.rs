@@ -15,8 +15,8 @@ use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
-    DIM, DamperRun, Engine, LaneObservation, LaneSettings, LaneStatus, LaneStep, Settled,
-    StepInLanes, integrate_runs_observed_with,
+    DIM, DamperRun, Engine, GridObservation, LaneObservation, LaneSettings, LaneStatus, LaneStep,
+    Settled, StepInLanes, integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -295,28 +295,34 @@ pub fn run_in_lanes<S: Sink + Default>(
         return Ok(results);
     };
     let mut io_error = None;
-    let outcomes = integrate_runs_observed_with(engine, &runs, &settings, &mut |k, step, rest| {
-        let w = &mut watched[k];
-        if interrupt.load(Ordering::Relaxed) {
-            w.status = Some(Status::Interrupted);
-            return false;
-        }
-        match w
-            .monitor
-            .after_step(&mut LaneView::new(step, rest), &mut w.sink)
-        {
-            Ok(None) => true,
-            Ok(Some(status)) => {
-                w.status = Some(status);
-                false
-            }
-            Err(e) => {
+    // A sink that reads only the nutation angle of a sample is offered nothing else.
+    let grid = match watched.first() {
+        Some(w) if w.sink.reads_only_nutation() => GridObservation::NutationAngle,
+        _ => GridObservation::Full,
+    };
+    let outcomes =
+        integrate_runs_observed_with(engine, &runs, &settings, grid, &mut |k, step, rest| {
+            let w = &mut watched[k];
+            if interrupt.load(Ordering::Relaxed) {
                 w.status = Some(Status::Interrupted);
-                io_error.get_or_insert(e);
-                false
+                return false;
             }
-        }
-    });
+            match w
+                .monitor
+                .after_step(&mut LaneView::new(step, rest), &mut w.sink)
+            {
+                Ok(None) => true,
+                Ok(Some(status)) => {
+                    w.status = Some(status);
+                    false
+                }
+                Err(e) => {
+                    w.status = Some(Status::Interrupted);
+                    io_error.get_or_insert(e);
+                    false
+                }
+            }
+        });
     if let Some(e) = io_error {
         return Err(e);
     }

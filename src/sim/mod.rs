@@ -214,6 +214,11 @@ pub trait Sink {
     fn nutation_sample(&mut self, _t: f64, _nutation_angle: f64) -> Option<std::io::Result<()>> {
         None
     }
+    /// Whether [`Sink::nutation_sample`] takes every sample it is offered, so that the
+    /// integrator need compute nothing but the nutation angle where it offers one.
+    fn reads_only_nutation(&self) -> bool {
+        false
+    }
 }
 
 /// A sink that discards everything (runs without logging).
@@ -637,37 +642,41 @@ fn keep_event(events: &mut Vec<EventRecord>, not_kept: &mut u64, e: EventRecord)
 }
 
 /// The first invariant (index, description) beyond its bound and not yet warned about.
-#[inline]
+#[inline(always)]
 fn drift_excess(
     limits: &DriftLimits,
     drift: &Drift,
     warned: &[bool; 3],
     t: f64,
 ) -> Option<(usize, String)> {
-    let momentum = drift.h_norm_rel.max(drift.h_inertial_rel);
-    let checks = [
-        (limits.momentum, momentum, "angular momentum (relative)"),
-        (limits.energy, drift.energy_rel, "energy balance (relative)"),
-        (
-            limits.quaternion_norm,
-            drift.q_norm,
-            "quaternion norm ||q| − 1|",
-        ),
+    let values = [
+        drift.h_norm_rel.max(drift.h_inertial_rel),
+        drift.energy_rel,
+        drift.q_norm,
     ];
-    checks
-        .iter()
-        .enumerate()
-        .find_map(|(i, (bound, value, name))| match bound {
-            Some(b) if !warned[i] && *value > *b => Some((
-                i,
-                format!(
-                    "the {name} drifted by {value:.3e} by t = {}, beyond the bound {b:e} \
-                     (checks.max_drift)",
-                    seconds(t)
-                ),
-            )),
-            _ => None,
-        })
+    let bounds = [limits.momentum, limits.energy, limits.quaternion_norm];
+    let (i, bound) = (0..3).find_map(|i| match bounds[i] {
+        Some(b) if !warned[i] && values[i] > b => Some((i, b)),
+        _ => None,
+    })?;
+    Some((i, excess_description(i, values[i], bound, t)))
+}
+
+/// What [`drift_excess`] says of invariant `i` (0: angular momentum, 1: energy balance,
+/// 2: quaternion norm) at `value`, beyond its bound `b`, at `t` (s).
+#[cold]
+#[inline(never)]
+fn excess_description(i: usize, value: f64, b: f64, t: f64) -> String {
+    let name = [
+        "angular momentum (relative)",
+        "energy balance (relative)",
+        "quaternion norm ||q| − 1|",
+    ][i];
+    format!(
+        "the {name} drifted by {value:.3e} by t = {}, beyond the bound {b:e} \
+         (checks.max_drift)",
+        seconds(t)
+    )
 }
 
 /// Time, state and what to do about drift beyond a bound.

@@ -126,7 +126,7 @@ pub(crate) struct Monitor<'a> {
     next_k: u64,
     last_sample_t: f64,
     last_obs: Observation,
-    /// Times of the current step's event-check points (its ends and interior points).
+    /// Times of the current step's interior event-check points (its ends are the step's).
     grid: Vec<f64>,
     /// Each watch's margin at each point of `grid`, point by point (`grid[p]`'s margins at
     /// `p * watches.len()..`): each margin computed once, and no observation kept.
@@ -241,8 +241,8 @@ impl<'a> Monitor<'a> {
             samples: 1,
             next_k: 1,
             last_sample_t: 0.0,
-            grid: Vec::with_capacity(interior_checks + 2),
-            grid_margins: Vec::with_capacity((interior_checks + 2) * n_watches),
+            grid: Vec::with_capacity(interior_checks),
+            grid_margins: Vec::with_capacity(interior_checks * n_watches),
             prev_margins,
             end_margins: Vec::with_capacity(n_watches),
             margins_before: vec![f64::NAN; n_watches],
@@ -303,7 +303,7 @@ impl<'a> Monitor<'a> {
         let sc = &sim.spacecraft;
         let t_end = sim.duration;
         let rate = sim.output_rate;
-        let limits = sim.drift_limits;
+        let limits = &sim.drift_limits;
         let n = sc.dim();
         let observe_for_events = |t: f64, y: &[f64]| sc.observe_for_events(t, y, watched_angles);
         let t0 = stepper.t_prev();
@@ -357,7 +357,7 @@ impl<'a> Monitor<'a> {
                 diagnosis: diagnose(&what, t1, stepper.y(), sim),
             }));
         }
-        if let Some((which, what)) = drift_excess(&limits, drift, warned, t1) {
+        if let Some((which, what)) = drift_excess(limits, drift, warned, t1) {
             let message = drift_message(&what, t1, stepper.y(), sim);
             match limits.on_drift {
                 OnBreach::Stop => return Ok(Some(Status::Failed { diagnosis: message })),
@@ -429,11 +429,10 @@ impl<'a> Monitor<'a> {
             if checks > 0 && !stepper.prepare_interpolation(sc) {
                 return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
             }
-            // Reused across steps: no allocation per step once it has grown.
+            // The interior points (reused across steps: no allocation per step once they have
+            // grown); the points are t0, the interior ones, t1.
             grid.clear();
             grid_margins.clear();
-            grid.push(t0);
-            grid_margins.extend_from_slice(prev_margins);
             for j in 1..=checks {
                 let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
                 stepper.interpolate(t, buf);
@@ -441,15 +440,21 @@ impl<'a> Monitor<'a> {
                 grid_margins.extend(watches.iter().map(|w| w.condition.margin(&o)));
                 grid.push(t);
             }
-            grid.push(t1);
-            grid_margins.extend_from_slice(end_margins);
-            std::mem::swap(prev_margins, end_margins);
-            let margin_at = |p: usize, w: usize| grid_margins[p * n_watches + w];
+            let last = checks + 1;
+            let time_at = |p: usize| match p {
+                0 => t0,
+                p if p == last => t1,
+                p => grid[p - 1],
+            };
+            let margin_at = |p: usize, w: usize| match p {
+                0 => prev_margins[w],
+                p if p == last => end_margins[w],
+                p => grid_margins[(p - 1) * n_watches + w],
+            };
             // A sign change is located on the dense output.
             let bracketed = watches.iter().enumerate().any(|(k, w)| {
                 w.active()
-                    && (1..grid.len())
-                        .any(|p| (margin_at(p - 1, k) > 0.0) != (margin_at(p, k) > 0.0))
+                    && (1..=last).any(|p| (margin_at(p - 1, k) > 0.0) != (margin_at(p, k) > 0.0))
             });
             if bracketed && !stepper.prepare_interpolation(sc) {
                 return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
@@ -459,8 +464,8 @@ impl<'a> Monitor<'a> {
                     continue;
                 }
                 let c = watch.condition;
-                for p in 1..grid.len() {
-                    let (a, b) = (grid[p - 1], grid[p]);
+                for p in 1..=last {
+                    let (a, b) = (time_at(p - 1), time_at(p));
                     let (ga, gb) = (margin_at(p - 1, k), margin_at(p, k));
                     let crossing = |up: bool| {
                         let mut scratch = vec![0.0; n];
@@ -487,6 +492,7 @@ impl<'a> Monitor<'a> {
                     }
                 }
             }
+            std::mem::swap(prev_margins, end_margins);
             found.sort_by(|a, b| a.1.total_cmp(&b.1));
             if let Some(i) = found.iter().position(|f| f.3) {
                 found.truncate(i + 1);
