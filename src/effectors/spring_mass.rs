@@ -192,13 +192,19 @@ impl<L: Lane> SpringMassLanes<L> {
         self.damping * u * u
     }
 
-    /// The two-body reduction's terms at offset `q`, rate `u` and hub rate `omega`, with hub
-    /// mass `hub_mass` (kg), for a unit direction.
+    /// The reduced mass m* = m M / (M + m) (kg) of the particle and a hub of mass `hub_mass`
+    /// (M, kg): a run's constant, formed once.
     #[inline(always)]
-    fn reduction(&self, q: L, u: L, omega: [L; 3], hub_mass: L) -> ReductionLanes<L> {
+    pub fn reduced_mass(&self, hub_mass: L) -> L {
+        self.mass * hub_mass / (hub_mass + self.mass)
+    }
+
+    /// The two-body reduction's terms at offset `q`, rate `u` and hub rate `omega`, with the
+    /// reduced mass `m_star` ([`SpringMassLanes::reduced_mass`]), for a unit direction.
+    #[inline(always)]
+    fn reduction(&self, q: L, u: L, omega: [L; 3], m_star: L) -> ReductionLanes<L> {
         use linalg::{add, cross, dot, scale, sub};
         let (p, rho_dot) = (self.direction, u);
-        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
         let r = add(self.position, scale(q, p));
         let c = add(
             cross(omega, cross(omega, r)),
@@ -217,7 +223,8 @@ impl<L: Lane> SpringMassLanes<L> {
     }
 
     /// The whole right-hand side of a hub (inertia `hub_inertia`, kg m² about its centre of
-    /// mass, as columns; mass `hub_mass`, kg) carrying this damper alone, in closed form
+    /// mass, as columns; `reduced_mass` [`SpringMassLanes::reduced_mass`] of its mass, kg)
+    /// carrying this damper alone, in closed form
     /// ([`ParticleModel::rhs_alone_closed_form`]): ω̇ and ρ̈ at offset `q` (m), rate `u`
     /// (m/s) and hub rate `omega` (rad/s). The direction must be a unit vector.
     #[inline(always)]
@@ -227,9 +234,9 @@ impl<L: Lane> SpringMassLanes<L> {
         u: L,
         omega: [L; 3],
         hub_inertia: &[[L; 3]; 3],
-        hub_mass: L,
+        reduced_mass: L,
     ) -> LoneAccelerations<L> {
-        let terms = self.reduction(q, u, omega, hub_mass);
+        let terms = self.reduction(q, u, omega, reduced_mass);
         // Column j, row i: m[j][i].
         let mut m = *hub_inertia;
         for (i, j, added) in terms.added_inertia() {

@@ -586,6 +586,8 @@ struct System<L: Lane> {
     spin_axis: [L; 3],
     hub_inertia: [[L; 3]; 3],
     hub_mass: L,
+    /// The damper's reduced mass with the hub (kg).
+    reduced_mass: L,
 }
 
 impl<L: Lane> System<L> {
@@ -596,9 +598,13 @@ impl<L: Lane> System<L> {
         let (y, dy) = (&y[..DIM], &mut dy[..DIM]);
         let omega = [y[0], y[1], y[2]];
         let (offset, rate) = (y[7], y[8]);
-        let a =
-            self.damper
-                .lone_accelerations(offset, rate, omega, &self.hub_inertia, self.hub_mass);
+        let a = self.damper.lone_accelerations(
+            offset,
+            rate,
+            omega,
+            &self.hub_inertia,
+            self.reduced_mass,
+        );
         let q_dot = linalg::quaternion_rate([y[3], y[4], y[5], y[6]], omega);
         dy[0] = a.omega_dot[0];
         dy[1] = a.omega_dot[1];
@@ -774,6 +780,7 @@ impl<L: Lane> Lanes<L> {
                 spin_axis: [z; 3],
                 hub_inertia: [[z; 3]; 3],
                 hub_mass: z,
+                reduced_mass: z,
             },
             atol: L::splat(settings.tolerances.atol),
             rtol: L::splat(settings.tolerances.rtol),
@@ -829,6 +836,8 @@ impl<L: Lane> Lanes<L> {
             }
         }
         set(&mut self.system.hub_mass, run.hub_mass);
+        let reduced_mass = run.damper.lanes().reduced_mass(run.hub_mass);
+        set(&mut self.system.reduced_mass, reduced_mass);
         for (j, &v) in run.initial_state().iter().enumerate() {
             set(&mut self.y[j], v);
         }

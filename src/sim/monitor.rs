@@ -123,7 +123,10 @@ pub(crate) struct Monitor<'a> {
     ranged: Vec<usize>,
     validity_reported: Vec<u8>,
     samples: u64,
+    /// Index k of the next time of the output grid, and that time k / rate (s), kept
+    /// together so that the division is made once per sample, not at every step.
     next_k: u64,
+    next_t: f64,
     last_sample_t: f64,
     last_obs: Observation,
     /// Times of the current step's interior event-check points (its ends are the step's).
@@ -240,11 +243,12 @@ impl<'a> Monitor<'a> {
             validity_reported,
             samples: 1,
             next_k: 1,
+            next_t: 1.0 / sim.output_rate,
             last_sample_t: 0.0,
             grid: Vec::with_capacity(interior_checks),
             grid_margins: Vec::with_capacity(interior_checks * n_watches),
             prev_margins,
-            end_margins: Vec::with_capacity(n_watches),
+            end_margins: vec![f64::NAN; n_watches],
             margins_before: vec![f64::NAN; n_watches],
             h_before: 0.0,
             last_good: None,
@@ -286,6 +290,7 @@ impl<'a> Monitor<'a> {
             ref mut validity_reported,
             ref mut samples,
             ref mut next_k,
+            ref mut next_t,
             ref mut last_sample_t,
             ref mut last_obs,
             ref mut grid,
@@ -327,8 +332,7 @@ impl<'a> Monitor<'a> {
         // the angles when a watch needs them). The drift check reads its invariants if it
         // was formed, and computes them alone otherwise.
         let mut o1: Option<Observation> = None;
-        end_margins.clear();
-        for watch in watches.iter() {
+        for (end_margin, watch) in end_margins.iter_mut().zip(watches.iter()) {
             let c = watch.condition;
             let value = match stepper.end_value(c.quantity) {
                 Some(v) => v,
@@ -338,7 +342,7 @@ impl<'a> Monitor<'a> {
                         .unwrap_or_else(|| observe_for_events(t1, stepper.y()))
                 })),
             };
-            end_margins.push(c.margin_of_value(value));
+            *end_margin = c.margin_of_value(value);
         }
         let terms = match (stepper.end_drift(), &o1) {
             (Some(terms), _) => terms,
@@ -493,15 +497,17 @@ impl<'a> Monitor<'a> {
                 }
             }
             std::mem::swap(prev_margins, end_margins);
-            found.sort_by(|a, b| a.1.total_cmp(&b.1));
-            if let Some(i) = found.iter().position(|f| f.3) {
-                found.truncate(i + 1);
+            if !found.is_empty() {
+                found.sort_by(|a, b| a.1.total_cmp(&b.1));
+                if let Some(i) = found.iter().position(|f| f.3) {
+                    found.truncate(i + 1);
+                }
             }
         }
         let stop_at = found.last().filter(|f| f.3).map(|f| f.1);
         let horizon = stop_at.unwrap_or(t1);
         // Samples and events inside the step are read from the dense output.
-        let inside = (*next_k as f64 / rate) < horizon.min(t1) || !found.is_empty();
+        let inside = *next_t < horizon.min(t1) || !found.is_empty();
         if inside && !stepper.prepare_interpolation(sc) {
             return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
         }
@@ -509,7 +515,7 @@ impl<'a> Monitor<'a> {
         // Samples on the grid up to the horizon, interleaved with events in time order.
         let mut pending = found.iter().peekable();
         loop {
-            let tk = *next_k as f64 / rate;
+            let tk = *next_t;
             let next_event_t = pending.peek().map(|f| f.1);
             let sample_due = tk <= horizon && tk <= t_end;
             match (sample_due, next_event_t) {
@@ -523,6 +529,7 @@ impl<'a> Monitor<'a> {
                         taken?;
                         *samples += 1;
                         *next_k += 1;
+                        *next_t = *next_k as f64 / rate;
                         *last_sample_t = tk;
                         continue;
                     }
@@ -547,6 +554,7 @@ impl<'a> Monitor<'a> {
                     sink.sample(&o, buf, inv)?;
                     *samples += 1;
                     *next_k += 1;
+                    *next_t = *next_k as f64 / rate;
                     *last_sample_t = tk;
                     continue;
                 }
