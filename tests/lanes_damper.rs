@@ -288,6 +288,33 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
     }
 }
 
+/// An observer that reads only the nutation angle at the output grid is handed the same
+/// angles at the same times as one that reads everything there, and nothing else.
+#[test]
+fn the_nutation_angle_alone_is_the_full_observations_angle() {
+    let mut runs = dispersed_runs(6, 5, |i| 15.0 + 2.0 * i as f64);
+    for run in &mut runs {
+        run.sample_rate = 20.0;
+    }
+    for engine in engines() {
+        let handed = |grid: GridObservation| {
+            let mut angles = vec![Vec::new(); runs.len()];
+            integrate_runs_observed_with(engine, &runs, &SETTINGS, grid, &mut |k, step, rest| {
+                if let Some(s) = step.sample {
+                    let full = rest.sample();
+                    assert_eq!(full.is_some(), grid == GridObservation::Full);
+                    angles[k].push((s.t.to_bits(), s.nutation_angle.to_bits()));
+                }
+                true
+            });
+            angles
+        };
+        let full = handed(GridObservation::Full);
+        assert!(full.iter().all(|a| a.len() > 100), "{engine:?}");
+        assert_eq!(full, handed(GridObservation::NutationAngle), "{engine:?}");
+    }
+}
+
 /// 12 dispersed draws to 60 s, all ending together: three full lanes of four.
 #[test]
 fn lanes_equal_the_scalar_runs_bit_for_bit() {
