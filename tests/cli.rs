@@ -326,6 +326,24 @@ fn run_writes_log_and_summary() {
     assert_eq!(per_channel["/scene"], 21);
 }
 
+/// `--summary -` prints the JSON summary (in place of the printed one) and writes no file
+/// named `-`.
+#[test]
+fn summary_dash_prints_the_json() {
+    let dir = scratch("summary-dash");
+    let file = write_scenario(&dir, "good.yaml", GOOD);
+    let out = polhode()
+        .current_dir(&dir)
+        .args(["run", file.to_str().unwrap(), "--no-log", "--summary", "-"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["final"]["t"].as_f64(), Some(2.0));
+    assert_eq!(json["samples"].as_u64(), Some(21));
+    assert!(!dir.join("-").exists());
+}
+
 #[test]
 fn overrides_from_the_command_line() {
     let dir = scratch("overrides");

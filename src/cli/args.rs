@@ -35,7 +35,8 @@ pub(super) enum Command {
         /// Simulated duration (s), overrides `duration`.
         #[arg(long)]
         duration: Option<f64>,
-        /// Write a JSON summary here.
+        /// Write a JSON summary here (or print it, in place of the printed summary, with
+        /// `--summary -`).
         #[arg(long)]
         summary: Option<PathBuf>,
         /// Write the sampled telemetry (every output sample, effectors' fields included) as

@@ -39,7 +39,10 @@ pub(super) struct LiveOptions {
 
 /// Runs the scenario at `path` with `overrides`, writing `outputs`; returns the exit code.
 pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quiet: bool) -> i32 {
-    let (no_log, summary_path) = (outputs.no_log, outputs.summary);
+    let no_log = outputs.no_log;
+    // `--summary -` prints the JSON summary on standard output, in place of the printed one.
+    let summary_to_stdout = outputs.summary == Some(Path::new("-"));
+    let summary_path = outputs.summary.filter(|_| !summary_to_stdout);
     let s = match load(path, overrides) {
         Ok(s) => s,
         Err(c) => return c,
@@ -292,7 +295,9 @@ pub(super) fn run(path: &Path, overrides: &Overrides, outputs: &RunOutputs, quie
             return EXIT_IO;
         }
     }
-    if !quiet {
+    if summary_to_stdout {
+        print!("{}", summary_json(&s, &outcome, written.as_deref()));
+    } else if !quiet {
         print_summary(&s, &outcome, written.as_deref());
         for p in &tables {
             println!("  table: {}", p.display());
