@@ -19,8 +19,9 @@
 //! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
 //! ([`Engine::Avx2`]), both asked through [`crate::cpu`], otherwise one lane
 //! ([`Engine::Scalar`]).
-//! [`integrate_runs_observed`] also hands each accepted step of each lane, with its dense
-//! output, to an observer that may end the run: the campaigns' run monitor (samples, events,
+//! [`integrate_runs_observed`] also hands each accepted step of each lane ([`LaneStep`], with
+//! the rest of it read out of the lanes on request: [`StepInLanes`]) to an observer that may
+//! end the run: the campaigns' run monitor (samples, events,
 //! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
 //! here: breakpoints (a scene with one does not take this class).
 
