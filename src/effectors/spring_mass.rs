@@ -7,7 +7,7 @@
 
 use super::particles::{ParticleModel, ParticlePoint, ParticleSums};
 use crate::lanes::{Lane, linalg};
-use crate::model::{Drawing, HubCoupling, Momentum, Validity, spd_inverse3};
+use crate::model::{Drawing, HubCoupling, Momentum, Validity};
 use nalgebra::{Matrix3, Vector3};
 
 /// A spring–mass–dashpot damper.
@@ -31,50 +31,10 @@ pub struct SpringMass {
 /// Fraction of the travel past which the damper warns that it nears its stop.
 pub const TRAVEL_WARN: f64 = 0.9;
 
-/// The terms of the two-body reduction ([`ParticleModel::couple_alone_closed_form`]) at one
-/// state.
-struct Reduction {
-    /// Reduced mass m* = m M/(M + m) (kg).
-    reduced_mass: f64,
-    /// Particle position r (m, body axes).
-    r: Vector3<f64>,
-    /// t = r × p̂ (m).
-    t: Vector3<f64>,
-    /// ρ̈ at ω̇ = 0: Q/m* − p̂·c (m/s²).
-    free_acceleration: f64,
-    /// r × (m* (c − p̂ (p̂·c)) + p̂ Q) (N m).
-    moment: Vector3<f64>,
-}
-
-impl Reduction {
-    /// The entries (row, column, value) of m* (|r|² 1 − r rᵀ − t tᵀ) on and below the
-    /// diagonal (kg m²).
-    #[inline(always)]
-    fn added_inertia(&self) -> [(usize, usize, f64); 6] {
-        let (r, t, r2) = (self.r, self.t, self.r.norm_squared());
-        let entry = |i: usize, j: usize| {
-            let diagonal = if i == j { r2 } else { 0.0 };
-            (
-                i,
-                j,
-                self.reduced_mass * (diagonal - r[i] * r[j] - t[i] * t[j]),
-            )
-        };
-        [
-            entry(0, 0),
-            entry(1, 0),
-            entry(2, 0),
-            entry(1, 1),
-            entry(2, 1),
-            entry(2, 2),
-        ]
-    }
-}
-
 impl SpringMass {
     /// The two-body reduction's terms at coordinate `q`, rate `u` and hub rate `omega`, with
-    /// hub mass `hub_mass` (kg); `None` for a direction that is not a unit vector (the
-    /// reduction is written for one, as scenarios give it).
+    /// hub mass `hub_mass` (kg), by the lanes' form at one lane; `None` for a direction that
+    /// is not a unit vector (the reduction is written for one, as scenarios give it).
     #[inline(always)]
     fn reduction(
         &self,
@@ -82,34 +42,18 @@ impl SpringMass {
         u: &[f64],
         omega: &Vector3<f64>,
         hub_mass: f64,
-    ) -> Option<Reduction> {
-        let (p, rho_dot) = (self.direction, u[0]);
-        if (p.norm_squared() - 1.0).abs() > 1e-12 {
+    ) -> Option<ReductionLanes<f64>> {
+        if (self.direction.norm_squared() - 1.0).abs() > 1e-12 {
             return None;
         }
-        let m_star = self.mass * hub_mass / (hub_mass + self.mass);
-        let r = self.position + q[0] * p;
-        let c = omega.cross(&omega.cross(&r)) + 2.0 * rho_dot * omega.cross(&p);
-        let mut generalised = [0.0];
-        self.forces(q, u, &mut generalised);
-        let generalised = generalised[0];
-        let pc = p.dot(&c);
-        let pull = m_star * (c - pc * p) + generalised * p;
-        Some(Reduction {
-            reduced_mass: m_star,
-            r,
-            t: r.cross(&p),
-            free_acceleration: generalised / m_star - pc,
-            moment: r.cross(&pull),
-        })
+        let lanes = self.lanes();
+        Some(lanes.reduction(q[0], u[0], (*omega).into(), lanes.reduced_mass(hub_mass)))
     }
 }
 
-// The lanes' form of the closed forms below (crate::lanes::damper). The scalar path keeps
-// its nalgebra form: the generic form at f64 gave the same bits but cost 3.7% more instructions
-// on scenarios/nutation-damper.yaml with matrices as rows, 1.8% with them as columns as here
-// (docs/montecarlo.md, "Lanes: the foundation"). The lane tests (tests/lanes_damper.rs) check
-// that the two agree bit for bit, run by run.
+// The closed forms below, written once over the lane type: the scalar path calls them at one
+// lane (`f64`, through [`SpringMass::lanes`]), the lockstep ensembles (crate::lanes::damper)
+// at four or eight.
 
 /// A spring–mass damper's parameters in lanes (one damper per lane): what its closed forms
 /// read, generic over the lane type so that the scalar path (at `f64`, through
@@ -360,7 +304,16 @@ impl ParticleModel for SpringMass {
         }
         // W = [ρ̈ at ω̇ = 0 | 0 0 0 | t], and L = 1.
         let t = terms.t;
-        kept[..8].copy_from_slice(&[terms.free_acceleration, 0.0, 0.0, 0.0, t.x, t.y, t.z, 1.0]);
+        kept[..8].copy_from_slice(&[
+            terms.free_acceleration,
+            0.0,
+            0.0,
+            0.0,
+            t[0],
+            t[1],
+            t[2],
+            1.0,
+        ]);
         true
     }
     /// The same reduction, solved: one symmetric 3 × 3 system by cofactors.
@@ -375,28 +328,24 @@ impl ParticleModel for SpringMass {
         omega_dot: &mut Vector3<f64>,
         u_dot: &mut [f64],
     ) -> bool {
-        let Some(terms) = self.reduction(q, u, omega, hub_mass) else {
+        if (self.direction.norm_squared() - 1.0).abs() > 1e-12 {
             return false;
-        };
-        let mut m = *hub_inertia;
-        for (i, j, added) in terms.added_inertia() {
-            m[(i, j)] += added;
         }
-        let force = -omega.cross(&(hub_inertia * omega)) - terms.moment;
-        let Some(inverse) = spd_inverse3(
-            m[(0, 0)],
-            m[(1, 0)],
-            m[(2, 0)],
-            m[(1, 1)],
-            m[(2, 1)],
-            m[(2, 2)],
-        ) else {
+        let lanes = self.lanes();
+        // Columns: hub_inertia[c][r] is I(r, c).
+        let columns = [0, 1, 2].map(|c| [0, 1, 2].map(|r| hub_inertia[(r, c)]));
+        let a = lanes.lone_accelerations(
+            q[0],
+            u[0],
+            (*omega).into(),
+            &columns,
+            lanes.reduced_mass(hub_mass),
+        );
+        if !a.solved {
             return false;
-        };
-        let w = inverse * force;
-        let t = terms.t;
-        *omega_dot = w;
-        u_dot[0] = terms.free_acceleration - t.x * w.x - t.y * w.y - t.z * w.z;
+        }
+        *omega_dot = a.omega_dot.into();
+        u_dot[0] = a.u_dot;
         true
     }
     fn momentum_closed_form(&self, q: &[f64], u: &[f64], omega: &Vector3<f64>) -> Option<Momentum> {
