@@ -43,7 +43,7 @@ impl SpringMass {
         omega: &Vector3<f64>,
         hub_mass: f64,
     ) -> Option<ReductionLanes<f64>> {
-        if (self.direction.norm_squared() - 1.0).abs() > 1e-12 {
+        if !self.has_unit_direction() {
             return None;
         }
         let lanes = self.lanes();
@@ -328,7 +328,7 @@ impl ParticleModel for SpringMass {
         omega_dot: &mut Vector3<f64>,
         u_dot: &mut [f64],
     ) -> bool {
-        if (self.direction.norm_squared() - 1.0).abs() > 1e-12 {
+        if !self.has_unit_direction() {
             return false;
         }
         let lanes = self.lanes();

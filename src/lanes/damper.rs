@@ -380,8 +380,7 @@ impl<L: Lane> StepInLanes for LaneRest<'_, L> {
         // the same, lane by lane).
         let (lanes, i) = (self.lanes, self.lane);
         let mut k = [[0.0; DIM]; 7];
-        L::gather_lane(&lanes.k_start, i, &mut k[0]);
-        for (k, stage) in k.iter_mut().zip(&lanes.k).skip(1) {
+        for (k, stage) in k.iter_mut().zip(lanes.step_stages()) {
             L::gather_lane(stage, i, k);
         }
         let (mut y_start, mut y_new) = ([0.0; DIM], [0.0; DIM]);
@@ -419,16 +418,22 @@ impl LaneStep {
         crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, y, cont, out);
     }
 
-    /// The step view of a run's end (`outcome`), with its state: no step to interpolate in.
-    pub fn at_end(outcome: &LaneOutcome) -> (Self, Settled) {
+    /// The step view of a run standing at `t` (s) in state `y` after the work `stats`, with
+    /// its state: no step to interpolate in.
+    pub fn settled(t: f64, y: [f64; DIM], stats: Stats) -> (Self, Settled) {
         let step = LaneStep {
-            t_prev: outcome.t,
-            t: outcome.t,
-            finite: outcome.y.iter().all(|v| v.is_finite()),
-            stats: outcome.stats,
+            t_prev: t,
+            t,
+            finite: y.iter().all(|v| v.is_finite()),
+            stats,
             ..LaneStep::default()
         };
-        (step, Settled(outcome.y))
+        (step, Settled(y))
+    }
+
+    /// [`LaneStep::settled`] at a run's end (`outcome`).
+    pub fn at_end(outcome: &LaneOutcome) -> (Self, Settled) {
+        Self::settled(outcome.t, outcome.y, outcome.stats)
     }
 }
 
@@ -878,6 +883,14 @@ impl<L: Lane> Lanes<L> {
         }
     }
 
+    /// The last attempted step's stages as its dense output reads them: its first stage as
+    /// it was at the step's start (`k[0]` holds the next step's once the step is accepted).
+    #[inline(always)]
+    fn step_stages(&self) -> [&[L; DIM]; 7] {
+        let [_, k2, k3, k4, k5, k6, k7] = &self.k;
+        [&self.k_start, k2, k3, k4, k5, k6, k7]
+    }
+
     /// Lane `i`'s last accepted step (of an observed integration), into `step`: the numbers
     /// read at every step, the rest left in the lanes ([`LaneRest`]).
     #[inline(always)]
@@ -1023,8 +1036,7 @@ impl<L: Lane> Lanes<L> {
             let mut y = [zero; DIM];
             // The step's dense output (what the observation does not read of it is dropped).
             let mut cont = [[zero; DIM]; 5];
-            let [_, k2, k3, k4, k5, k6, k7] = &self.k;
-            let k = [&self.k_start, k2, k3, k4, k5, k6, k7];
+            let k = self.step_stages();
             dense_coefficients(self.h_step, &k, &self.y_start, &self.y_new, &mut cont);
             dense_interior(t_k, self.t_prev, self.t, &cont, &mut y);
             let observation = self.system.observe(&y);
@@ -1108,7 +1120,8 @@ impl<L: Lane> Lanes<L> {
         );
         self.fac_old = L::select(accept, fac_old, self.fac_old);
         if observed {
-            // For every lane (the others' are not read): the scalar `Dopri5`'s coefficients.
+            // What the step's dense output is formed of where it is read (for every lane;
+            // the others' are not read).
             self.y_start = self.y;
             self.k_start = self.k[0];
             self.h_step = h;

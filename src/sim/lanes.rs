@@ -16,7 +16,7 @@ use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
 use crate::lanes::damper::{
     DIM, DamperRun, Engine, GridObservation, LaneObservation, LaneSettings, LaneStatus, LaneStep,
-    Settled, StepInLanes, integrate_runs_observed_with,
+    StepInLanes, integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -274,12 +274,8 @@ pub fn run_in_lanes<S: Sink + Default>(
         let steps_ahead = sim.duration > 0.0;
         if status.is_some() || !steps_ahead {
             // Ended at t = 0, as the scalar loop does without a step.
-            let start = LaneStep {
-                finite: y0.iter().all(|v| v.is_finite()),
-                ..LaneStep::default()
-            };
-            let outcome =
-                monitor.finish(&LaneView::new(&start, &Settled(y0)), status, &mut sink)?;
+            let (start, state) = LaneStep::settled(0.0, y0, Stats::default());
+            let outcome = monitor.finish(&LaneView::new(&start, &state), status, &mut sink)?;
             results[index] = Some((outcome, sink));
             continue;
         }

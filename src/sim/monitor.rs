@@ -523,35 +523,32 @@ impl<'a> Monitor<'a> {
                 (true, _) => {
                     // A sink that reads only the nutation angle takes it as the stepper hands
                     // it, without an observation.
-                    if let Some(angle) = stepper.nutation_at(tk)
-                        && let Some(taken) = sink.nutation_sample(tk, angle)
-                    {
+                    let taken_as_angle = stepper
+                        .nutation_at(tk)
+                        .and_then(|angle| sink.nutation_sample(tk, angle));
+                    if let Some(taken) = taken_as_angle {
                         taken?;
-                        *samples += 1;
-                        *next_k += 1;
-                        *next_t = *next_k as f64 / rate;
-                        *last_sample_t = tk;
-                        continue;
-                    }
-                    let o = if tk == t1 {
-                        buf.copy_from_slice(stepper.y());
-                        match &o1 {
-                            Some(o) if watched_angles || !sample_angles => o.clone(),
-                            Some(o) => Observation {
-                                angles_to_principal: sc.angles_to_principal(&o.omega),
-                                ..o.clone()
-                            },
-                            None => stepper
-                                .end_observation(sc, sample_angles)
-                                .unwrap_or_else(|| sc.observe_for_events(t1, buf, sample_angles)),
-                        }
-                    } else if let Some(o) = stepper.observe_at(tk, sc, sample_angles, buf) {
-                        o
                     } else {
-                        stepper.interpolate(tk, buf);
-                        sc.observe_for_events(tk, buf, sample_angles)
-                    };
-                    sink.sample(&o, buf, inv)?;
+                        let o = if tk == t1 {
+                            buf.copy_from_slice(stepper.y());
+                            match &o1 {
+                                Some(o) if watched_angles || !sample_angles => o.clone(),
+                                Some(o) => Observation {
+                                    angles_to_principal: sc.angles_to_principal(&o.omega),
+                                    ..o.clone()
+                                },
+                                None => stepper.end_observation(sc, sample_angles).unwrap_or_else(
+                                    || sc.observe_for_events(t1, buf, sample_angles),
+                                ),
+                            }
+                        } else if let Some(o) = stepper.observe_at(tk, sc, sample_angles, buf) {
+                            o
+                        } else {
+                            stepper.interpolate(tk, buf);
+                            sc.observe_for_events(tk, buf, sample_angles)
+                        };
+                        sink.sample(&o, buf, inv)?;
+                    }
                     *samples += 1;
                     *next_k += 1;
                     *next_t = *next_k as f64 / rate;
