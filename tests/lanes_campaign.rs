@@ -10,7 +10,7 @@
 //!
 //!   cargo test --release --test lanes_campaign
 
-use polhode::lanes::damper::{Engine, resolved};
+use polhode::lanes::ensemble::{Engine, resolved};
 use polhode::montecarlo::{Integration, Prepared, Row};
 use polhode::scenario::{self, Overrides};
 use std::path::Path;

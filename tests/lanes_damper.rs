@@ -15,8 +15,9 @@ use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use polhode::effectors::particles::ParticleEffector;
 use polhode::effectors::spring_mass::SpringMass;
 use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
-use polhode::lanes::damper::{
-    DamperRun, Engine, GridObservation, LaneObservation, LaneOutcome, LaneSettings, LaneStatus,
+use polhode::lanes::damper::{DIM, DamperRun};
+use polhode::lanes::ensemble::{
+    Engine, GridObservation, LaneObservation, LaneOutcome, LaneSettings, LaneStatus,
     integrate_runs, integrate_runs_observed_with, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
@@ -114,7 +115,7 @@ fn scalar(run: &DamperRun) -> (f64, Vec<f64>, Stats) {
     (s.t(), s.y().to_vec(), s.stats())
 }
 
-fn assert_bitwise_equal(engine: Engine, runs: &[DamperRun], lanes: &[LaneOutcome]) {
+fn assert_bitwise_equal(engine: Engine, runs: &[DamperRun], lanes: &[LaneOutcome<DIM>]) {
     assert_eq!(lanes.len(), runs.len());
     for (i, (run, lane)) in runs.iter().zip(lanes).enumerate() {
         let (t, y, stats) = scalar(run);

@@ -1,7 +1,7 @@
 //! `polhode montecarlo` and `polhode merge`: campaigns, whole or in shards.
 
 use super::{EXIT_BAD_INPUT, EXIT_INTERRUPTED, EXIT_IO};
-use crate::lanes::damper::Engine;
+use crate::lanes::ensemble::Engine;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -52,12 +52,12 @@ impl SpringMass {
 }
 
 // The closed forms below, written once over the lane type: the scalar path calls them at one
-// lane (`f64`, through [`SpringMass::lanes`]), the lockstep ensembles (crate::lanes::damper)
+// lane (`f64`, through [`SpringMass::lanes`]), the lockstep ensembles (crate::lanes::ensemble)
 // at four or eight.
 
 /// A spring–mass damper's parameters in lanes (one damper per lane): what its closed forms
 /// read, generic over the lane type so that the scalar path (at `f64`, through
-/// [`SpringMass::lanes`]) and the lockstep ensembles (crate::lanes::damper) run one code.
+/// [`SpringMass::lanes`]) and the lockstep ensembles (crate::lanes::ensemble) run one code.
 #[derive(Debug, Clone, Copy)]
 pub struct SpringMassLanes<L> {
     /// Particle mass (kg).

@@ -19,13 +19,14 @@
 //! AVX-512 register, x86-64 only, crate-private), [`linalg`] (3-vectors,
 //! 3 × 3 products, the SPD inverse and the quaternion rate, in lanes), [`elementary`] (the
 //! arctangent and the power that the monitor and the step-size control call every step, in
-//! lanes and at f64 alike), [`damper`] (the
-//! lockstep dopri5 ensemble of the nutation-damper class, with the AVX2 and AVX-512
-//! dispatch). docs/montecarlo.md,
+//! lanes and at f64 alike), [`ensemble`] (the lockstep dopri5 ensemble, with the AVX2 and
+//! AVX-512 dispatch, generic over the class of runs it integrates: [`ensemble::LaneRun`] and
+//! [`ensemble::LaneSystem`]), [`damper`] (the nutation-damper class). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;
 pub mod elementary;
+pub mod ensemble;
 pub mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;

@@ -23,7 +23,7 @@ pub use spec::{Campaign, InvalidDraws, MAX_DRAWS_PER_RUN, MAX_RUNS};
 pub use summary::{percentile, wilson95};
 pub use table::{Row, RunStatus};
 
-use crate::lanes::damper::Engine;
+use crate::lanes::ensemble::Engine;
 use crate::log::telemetry;
 use crate::model::Observation;
 use crate::scenario::{self, Overrides, Quantity, Scenario, ScenarioError};
@@ -145,7 +145,7 @@ impl Integration {
     /// (or the nearest it has) where the scene has a lane form.
     pub fn of(scenario: &Scenario, engine: Engine) -> Self {
         match sim::lane_form(scenario) {
-            Ok(_) => Integration::Lanes(crate::lanes::damper::resolved(engine)),
+            Ok(_) => Integration::Lanes(crate::lanes::ensemble::resolved(engine)),
             Err(why) => Integration::Scalar(format!("the scene has no lane form: {why}")),
         }
     }

@@ -14,9 +14,10 @@ use super::{
 use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
-use crate::lanes::damper::{
-    DIM, DamperRun, Engine, GridObservation, LaneObservation, LaneSettings, LaneStatus, LaneStep,
-    StepInLanes, integrate_runs_observed_with,
+use crate::lanes::damper::{DIM, DamperRun};
+use crate::lanes::ensemble::{
+    Engine, GridObservation, LaneObservation, LaneSettings, LaneStatus, LaneStep, StepInLanes,
+    integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -28,13 +29,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// read out of the lanes the first time the monitor asks for them.
 struct LaneView<'s> {
     step: &'s LaneStep,
-    rest: &'s dyn StepInLanes,
+    rest: &'s dyn StepInLanes<DIM>,
     y: OnceCell<[f64; DIM]>,
     cont: OnceCell<[[f64; DIM]; 5]>,
 }
 
 impl<'s> LaneView<'s> {
-    fn new(step: &'s LaneStep, rest: &'s dyn StepInLanes) -> Self {
+    fn new(step: &'s LaneStep, rest: &'s dyn StepInLanes<DIM>) -> Self {
         LaneView {
             step,
             rest,

@@ -161,7 +161,7 @@ impl Reference {
 
     /// The drift at one state with invariants `i`: each field of [`Drift`] at that state
     /// alone (the lanes compute the same terms, with the same operations:
-    /// `lanes::damper::LaneDrift`).
+    /// `lanes::ensemble::LaneDrift`).
     pub fn terms(&self, i: &Invariants) -> Drift {
         // With a thruster, H plus what the exhaust carried out is the conserved quantity (the
         // carried part is zero otherwise).

@@ -1,0 +1,1113 @@
+//! The lockstep dopri5 ensemble: W runs of one class integrated at once, one per lane
+//! ([`Lane`]), whatever the class ([`LaneRun`]: one run's parameters and start; its
+//! [`LaneSystem`]: the runs' parameters in lanes, their right-hand side and observation).
+//!
+//! Each lane has its own initial state, parameters, end time, step size, error control,
+//! accept/reject and work counters. Every lane evaluates every stage (lockstep, as
+//! DiffEqGPU.jl's `EnsembleGPUKernel` does on GPUs: U. Utkarsh et al., "Automated translation
+//! and accelerated solving of differential equations on multiple GPU platforms", Comput.
+//! Methods Appl. Mech. Eng. 419 (2024) 116591); the decisions are taken per lane under masks.
+//! A lane whose run has ended takes the next run. The arithmetic is the scalar path's, generic
+//! over the lane (dopri5's stages, error norm and controller in `integrate::dopri5`; the
+//! class's right-hand side and observation, which its [`LaneSystem`] writes with the scalar
+//! path's operations), so each lane's steps, rejections, right-hand-side count and final state
+//! are bit for bit those of the scalar `Dopri5` on that run's `Spacecraft`, stepped to the
+//! same end time. The engine knows no class: a class joins the lanes by implementing the two
+//! traits ([`super::damper`], the nutation-damper class, is the first).
+//!
+//! [`integrate_runs`] picks the engine at run time: eight f64 lanes compiled for AVX-512
+//! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
+//! ([`Engine::Avx2`]), both asked through [`crate::cpu`], otherwise one lane
+//! ([`Engine::Scalar`]).
+//! [`integrate_runs_observed`] also hands each accepted step of each lane ([`LaneStep`], with
+//! the rest of it read out of the lanes on request: [`StepInLanes`]) to an observer that may
+//! end the run: the campaigns' run monitor (samples, events,
+//! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
+//! here: breakpoints (a scene with one takes no class).
+
+use super::{F64x4, Lane, LaneMask, linalg};
+use crate::integrate::dopri5::{
+    MAX_REJECTIONS, StageRhs, accepted_step_size, dense_coefficients, dense_interior, error_factor,
+    error_norm, initial_step, kept_proposal, non_finite_step_size, rejected_step_size, stages,
+};
+use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
+
+/// One run of a class the lanes integrate, whose state has `DIM` components (the scalar
+/// `Spacecraft`'s layout for the class's scene).
+pub trait LaneRun<const DIM: usize>: Sized {
+    /// The class's runs in lanes of type `L`.
+    type System<L: Lane>: LaneSystem<L, DIM, Self>;
+    /// The state at t = 0.
+    fn initial_state(&self) -> [f64; DIM];
+    /// End time (s); the run starts at t = 0.
+    fn t_end(&self) -> f64;
+    /// Rate of the output grid k / `sample_rate` (Hz) on which an observed integration also
+    /// hands the observer the state and its observation at the step's first grid time
+    /// ([`LaneStep::sample`]); 0 (or not finite): none.
+    fn sample_rate(&self) -> f64;
+    /// Whether the lanes take the run at all; one they do not take ends at t = 0 as
+    /// [`LaneStatus::Declined`].
+    fn admitted(&self) -> bool;
+}
+
+/// The parameters of the runs of class `R` in the lanes, one run per lane, and what the
+/// lanes compute from them. Both are written with the operations (and their order) of the
+/// scalar path's code for the class, so that every lane's numbers are the scalar path's, bit
+/// for bit.
+pub trait LaneSystem<L: Lane, const DIM: usize, R> {
+    /// Every lane empty (zero parameters).
+    fn idle() -> Self;
+    /// Puts `run`'s parameters into lane `i`.
+    fn load(&mut self, i: usize, run: &R);
+    /// The right-hand side at `y` (`DIM` components) into `dy`; returns the lanes whose
+    /// closed form was solved (the others declined the state: [`LaneStatus::Declined`]).
+    fn rhs(&self, y: &[L], dy: &mut [L]) -> L::Mask;
+    /// The observation at `y`, as `Spacecraft::observe` forms it (the nutation angle's
+    /// arctangent by [`super::elementary::half_plane_atan2`], the scalar path's too).
+    fn observe(&self, y: &[L; DIM]) -> LaneObservation<L>;
+}
+
+/// The integration settings every run of a campaign shares (as the scalar `Dopri5::new`
+/// takes them, with the first step chosen automatically).
+#[derive(Debug, Clone, Copy)]
+pub struct LaneSettings {
+    /// Tolerances of the error control.
+    pub tolerances: Tolerances,
+    /// Largest step (s); `f64::INFINITY` for none.
+    pub h_max: f64,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LaneStatus {
+    /// Reached its end time.
+    Complete,
+    /// Failed as the scalar `Dopri5::step` would have (the same error).
+    Failed(StepError),
+    /// The class's closed form declined a state (for the nutation damper: a direction that is
+    /// not a unit vector, a 3 × 3 system that is not positive definite, a non-finite state)
+    /// at time `t` (s), or the run itself ([`LaneRun::admitted`], `t` = 0): the scalar path
+    /// would have taken the general right-hand side there, which the lanes do not have.
+    /// Integrate this run through the scalar path.
+    Declined {
+        /// Start of the step in which it happened (s).
+        t: f64,
+    },
+    /// Ended by the observer of [`integrate_runs_observed`] after an accepted step (a
+    /// terminal event, a failed check, an interrupt).
+    Ended,
+}
+
+/// An accepted step of one lane, as [`integrate_runs_observed`] hands it to its observer: the
+/// few numbers a run monitor reads at every step (the step's ends, its work, its drift, the
+/// nutation angle at its end and at its first grid time). The rest (the state, the whole
+/// observations, the dense output) stays in the lanes, read out for that lane only when asked
+/// ([`StepInLanes`]).
+#[derive(Debug, Clone, Default)]
+pub struct LaneStep {
+    /// Start of the step (s).
+    pub t_prev: f64,
+    /// End of the step (s).
+    pub t: f64,
+    /// Whether every component of the state at the end of the step is finite.
+    pub finite: bool,
+    /// Work so far: accepted and rejected steps, right-hand-side evaluations.
+    pub stats: Stats,
+    /// The nutation angle (rad) of the observation at the end of the step (of an observed
+    /// integration).
+    pub end_nutation_angle: f64,
+    /// The kinetic energy (J) of that observation.
+    pub end_kinetic_energy: f64,
+    /// The run's drift at the end of the step from its start (of an observed integration).
+    pub drift: LaneDrift,
+    /// The first time of the run's output grid strictly inside the step, if there is one, with
+    /// the nutation angle there (of an observed integration; the state and the whole
+    /// observation there: [`StepInLanes::sample`]).
+    pub sample: Option<GridAngle>,
+}
+
+/// What an observed integration computes at the output grid time inside a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GridObservation {
+    /// The state there and its whole observation ([`StepInLanes::sample`]).
+    Full,
+    /// The nutation angle alone ([`LaneStep::sample`]), for an observer that reads nothing
+    /// else there; [`StepInLanes::sample`] is `None`. The operations are [`Full`]'s (the
+    /// compiler drops what the angle does not need), so the angle is the same.
+    ///
+    /// [`Full`]: GridObservation::Full
+    NutationAngle,
+}
+
+/// A time of a run's output grid and the nutation angle there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridAngle {
+    /// The grid time (s): k / `sample_rate`.
+    pub t: f64,
+    /// The nutation angle there (rad).
+    pub nutation_angle: f64,
+}
+
+/// The state at one time of the output grid inside a step, from the step's dense output (as
+/// [`LaneStep::interpolate`] gives it), and its observation.
+#[derive(Debug, Clone, Copy)]
+pub struct LaneSample<const DIM: usize> {
+    /// The grid time (s): k / `sample_rate`.
+    pub t: f64,
+    /// The state there.
+    pub y: [f64; DIM],
+    /// Its observation.
+    pub observation: LaneObservation,
+}
+
+/// What the run monitor observes of a lane's state, computed in the lanes with the operations
+/// of `Spacecraft::observe` for the run's class ([`LaneSystem::observe`]), so that each value
+/// is bit for bit the scalar observation's (the rest of the observation is formed from these per lane). `T` is one
+/// value ([`f64`]) or one per lane.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LaneObservation<T = f64> {
+    /// Attitude, the state's quaternion divided by its norm (w, x, y, z).
+    pub attitude: [T; 4],
+    /// `|q| − 1`.
+    pub q_norm_error: T,
+    /// Angular momentum about the system's centre of mass, body axes (N m s).
+    pub h_body: [T; 3],
+    /// The same in inertial axes (N m s).
+    pub h_inertial: [T; 3],
+    /// Kinetic energy (J).
+    pub kinetic_energy: T,
+    /// The effectors' elastic energy (J).
+    pub elastic_energy: T,
+    /// Energy the effectors have dissipated (J).
+    pub dissipated_energy: T,
+    /// The effectors' dissipation rate (W).
+    pub dissipation_power: T,
+    /// |H| (N m s), nalgebra's norm of `h_body`.
+    pub h_norm: T,
+    /// The nutation angle (rad), between the spin axis a and H, from |a × H| and a · H, as
+    /// `observe::angle_between` forms it (the arctangent in the lanes:
+    /// [`crate::lanes::elementary::half_plane_atan2`]).
+    pub nutation_angle: T,
+}
+
+impl<L: Lane> LaneObservation<L> {
+    /// Lane `i`'s values.
+    #[inline(always)]
+    fn lane(&self, i: usize) -> LaneObservation {
+        let mut o = LaneObservation {
+            q_norm_error: read(&self.q_norm_error, i),
+            kinetic_energy: read(&self.kinetic_energy, i),
+            elastic_energy: read(&self.elastic_energy, i),
+            dissipated_energy: read(&self.dissipated_energy, i),
+            dissipation_power: read(&self.dissipation_power, i),
+            h_norm: read(&self.h_norm, i),
+            nutation_angle: read(&self.nutation_angle, i),
+            ..LaneObservation::default()
+        };
+        L::gather_lane(&self.attitude, i, &mut o.attitude);
+        L::gather_lane(&self.h_body, i, &mut o.h_body);
+        L::gather_lane(&self.h_inertial, i, &mut o.h_inertial);
+        o
+    }
+}
+
+/// A run's drift at a state from its start (t = 0), computed in the lanes with the operations
+/// (and their order) of the run monitor's drift check (`sim::Reference`), so that each term is
+/// bit for bit the scalar path's: |H₀| is the body-frame |H| at t = 0 (nalgebra's norm,
+/// `√(0 + ((x² + y²) + z²))`), E is kinetic + elastic + dissipated energy, and the classes
+/// the lanes have carry no momentum out and have no external work (the scalar sums add their zeros). `T` is
+/// one value ([`f64`]) or one per lane.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct LaneDrift<T = f64> {
+    /// |(|H_N| − |H₀|)| / |H₀| (|H₀| = 0: not divided).
+    pub h_norm_rel: T,
+    /// |H_N − H_N₀| / |H₀|.
+    pub h_inertial_rel: T,
+    /// |E − E₀| / E₀ (E₀ = 0: not divided).
+    pub energy_rel: T,
+    /// ||q| − 1|.
+    pub q_norm: T,
+}
+
+impl<L: Lane> LaneDrift<L> {
+    /// Lane `i`'s terms.
+    #[inline(always)]
+    fn lane(&self, i: usize) -> LaneDrift {
+        LaneDrift {
+            h_norm_rel: read(&self.h_norm_rel, i),
+            h_inertial_rel: read(&self.h_inertial_rel, i),
+            energy_rel: read(&self.energy_rel, i),
+            q_norm: read(&self.q_norm, i),
+        }
+    }
+}
+
+/// What the drift is measured against, per lane: the observation at t = 0.
+#[derive(Debug, Clone, Copy)]
+struct DriftReference<L: Lane> {
+    /// |H| at t = 0, body axes (N m s).
+    h0: L,
+    /// H at t = 0, inertial axes (N m s).
+    h_inertial0: [L; 3],
+    /// The energy balance at t = 0 (J).
+    e0: L,
+}
+
+/// `d / reference`, or `d` where the reference is zero (the monitor's `rel`).
+#[inline(always)]
+fn relative<L: Lane>(d: L, reference: L) -> L {
+    L::select(!reference.equals(L::splat(0.0)), d / reference, d)
+}
+
+impl<L: Lane> LaneObservation<L> {
+    /// The energy balance, kinetic + elastic + dissipated − external work (none here), in
+    /// the order of `Invariants::energy_balance`.
+    #[inline(always)]
+    fn energy_balance(&self) -> L {
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - L::splat(0.0)
+    }
+
+    /// H_N plus the (zero) momentum carried out, as the monitor audits it.
+    #[inline(always)]
+    fn h_audited(&self) -> [L; 3] {
+        linalg::add(self.h_inertial, [L::splat(0.0); 3])
+    }
+
+    /// What the drift of later states is measured against, this being the state at t = 0.
+    #[inline(always)]
+    fn drift_reference(&self) -> DriftReference<L> {
+        DriftReference {
+            h0: linalg::norm(self.h_body),
+            h_inertial0: self.h_inertial,
+            e0: self.energy_balance(),
+        }
+    }
+
+    /// The drift at this state from `reference`, as the monitor's check computes it.
+    #[inline(always)]
+    fn drift(&self, reference: &DriftReference<L>) -> LaneDrift<L> {
+        let r = reference;
+        let h = self.h_audited();
+        LaneDrift {
+            h_norm_rel: relative(linalg::norm(h) - r.h0, r.h0).abs(),
+            h_inertial_rel: relative(linalg::norm(linalg::sub(h, r.h_inertial0)), r.h0),
+            energy_rel: relative(self.energy_balance() - r.e0, r.e0).abs(),
+            q_norm: self.q_norm_error.abs(),
+        }
+    }
+}
+
+/// The rest of the step a lane has just accepted ([`LaneStep`]), still in the lanes: read out
+/// of them for that lane only when asked, since a run monitor rarely needs more than the
+/// step hands it (copying it all out at every step cost a tenth of a campaign).
+pub trait StepInLanes<const DIM: usize> {
+    /// The state at the end of the step (the class's layout, [`LaneRun::initial_state`]), into `out`.
+    fn state(&self, out: &mut [f64; DIM]);
+    /// The observation at the end of the step (of an observed integration).
+    fn end(&self) -> LaneObservation;
+    /// The step's first grid time strictly inside it, if there is one, with the state there
+    /// and its observation (of an observed integration).
+    fn sample(&self) -> Option<LaneSample<DIM>>;
+    /// The step's dense-output coefficients (those of the scalar `Dopri5`), into `out`.
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]);
+}
+
+/// Lane `i` of `value`, read where it lies (a method called outside the engine's compiled
+/// instruction set may not hold the lane type in a register).
+#[inline(always)]
+fn read<L: Lane>(value: &L, i: usize) -> f64 {
+    let mut x = [0.0];
+    L::gather_lane(std::slice::from_ref(value), i, &mut x);
+    x[0]
+}
+
+/// Lane `lane`'s step in the lanes.
+struct LaneRest<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> {
+    lanes: &'a Lanes<L, R, DIM>,
+    lane: usize,
+}
+
+impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> StepInLanes<DIM> for LaneRest<'_, L, R, DIM> {
+    fn state(&self, out: &mut [f64; DIM]) {
+        L::gather_lane(&self.lanes.y, self.lane, out);
+    }
+    fn end(&self) -> LaneObservation {
+        self.lanes
+            .end
+            .as_ref()
+            .map_or_else(LaneObservation::default, |e| e.lane(self.lane))
+    }
+    fn sample(&self) -> Option<LaneSample<DIM>> {
+        let i = self.lane;
+        match &self.lanes.sample {
+            Some(SampleLanes {
+                due,
+                t,
+                full: Some((y, observation)),
+                ..
+            }) if due.test(i) => {
+                let mut sample = LaneSample {
+                    t: read(t, i),
+                    y: [0.0; DIM],
+                    observation: observation.lane(i),
+                };
+                L::gather_lane(y, i, &mut sample.y);
+                Some(sample)
+            }
+            _ => None,
+        }
+    }
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
+        // The scalar `Dopri5`'s arithmetic on this lane's stages (the lanes' arithmetic is
+        // the same, lane by lane).
+        let (lanes, i) = (self.lanes, self.lane);
+        let mut k = [[0.0; DIM]; 7];
+        for (k, stage) in k.iter_mut().zip(lanes.step_stages()) {
+            L::gather_lane(stage, i, k);
+        }
+        let (mut y_start, mut y_new) = ([0.0; DIM], [0.0; DIM]);
+        L::gather_lane(&lanes.y_start, i, &mut y_start);
+        L::gather_lane(&lanes.y_new, i, &mut y_new);
+        dense_coefficients(read(&lanes.h_step, i), &k, &y_start, &y_new, out);
+    }
+}
+
+/// A run's state where it stands, with no step in the lanes: at its start, or at its end
+/// ([`LaneStep::at_end`]). There is nothing to interpolate in (`t_prev = t`).
+#[derive(Debug, Clone)]
+pub struct Settled<const DIM: usize>(pub [f64; DIM]);
+
+impl<const DIM: usize> StepInLanes<DIM> for Settled<DIM> {
+    fn state(&self, out: &mut [f64; DIM]) {
+        *out = self.0;
+    }
+    fn end(&self) -> LaneObservation {
+        LaneObservation::default()
+    }
+    fn sample(&self) -> Option<LaneSample<DIM>> {
+        None
+    }
+    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
+        *out = [[0.0; DIM]; 5];
+    }
+}
+
+impl LaneStep {
+    /// The state at `t` (s) in the step, from its end state `y` ([`StepInLanes::state`]) and
+    /// its dense-output coefficients `cont` ([`StepInLanes::coefficients`]), as the scalar
+    /// `Dopri5` interpolates.
+    pub fn interpolate<const DIM: usize>(
+        &self,
+        y: &[f64; DIM],
+        cont: &[[f64; DIM]; 5],
+        t: f64,
+        out: &mut [f64],
+    ) {
+        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, y, cont, out);
+    }
+
+    /// The step view of a run standing at `t` (s) in state `y` after the work `stats`, with
+    /// its state: no step to interpolate in.
+    pub fn settled<const DIM: usize>(t: f64, y: [f64; DIM], stats: Stats) -> (Self, Settled<DIM>) {
+        let step = LaneStep {
+            t_prev: t,
+            t,
+            finite: y.iter().all(|v| v.is_finite()),
+            stats,
+            ..LaneStep::default()
+        };
+        (step, Settled(y))
+    }
+
+    /// [`LaneStep::settled`] at a run's end (`outcome`).
+    pub fn at_end<const DIM: usize>(outcome: &LaneOutcome<DIM>) -> (Self, Settled<DIM>) {
+        Self::settled(outcome.t, outcome.y, outcome.stats)
+    }
+}
+
+/// What a run ended with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LaneOutcome<const DIM: usize> {
+    /// How it ended.
+    pub status: LaneStatus,
+    /// Time reached (s).
+    pub t: f64,
+    /// State reached (the class's layout).
+    pub y: [f64; DIM],
+    /// Work: accepted and rejected steps, right-hand-side evaluations (the rest zero).
+    pub stats: Stats,
+}
+
+/// What [`integrate_runs_observed`] calls after each accepted step of a run: `(run, step,
+/// rest)`, the run's index, its step and the rest of the step in the lanes; false ends the
+/// run there.
+pub type Observer<'o, const DIM: usize> =
+    &'o mut dyn FnMut(usize, &LaneStep, &dyn StepInLanes<DIM>) -> bool;
+
+/// Which compiled engine runs the lanes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Engine {
+    /// The widest the processor has: [`Engine::Avx512`], else [`Engine::Avx2`], else
+    /// [`Engine::Scalar`].
+    Auto,
+    /// One lane (`f64`): the same lockstep code at width 1.
+    Scalar,
+    /// Four lanes ([`F64x4`]) compiled for the baseline target (SSE2 on x86-64): for
+    /// comparison only.
+    Portable4,
+    /// Four lanes compiled for AVX2; falls back to [`Engine::Scalar`] on a processor
+    /// without it.
+    Avx2,
+    /// Eight lanes in AVX-512 registers (intrinsics, x86-64 only); falls back to
+    /// [`Engine::Avx2`] (and on to [`Engine::Scalar`]) on a processor without it.
+    Avx512,
+}
+
+impl Engine {
+    /// Runs integrated at once on one thread.
+    pub fn width(self) -> usize {
+        match resolved(self) {
+            Engine::Portable4 | Engine::Avx2 => 4,
+            Engine::Avx512 => 8,
+            _ => 1,
+        }
+    }
+}
+
+/// Integrates every run to its end time with the engine chosen at run time
+/// ([`Engine::Auto`]); the outcomes are in the order of `runs`.
+pub fn integrate_runs<R: LaneRun<DIM>, const DIM: usize>(
+    runs: &[R],
+    settings: &LaneSettings,
+) -> Vec<LaneOutcome<DIM>> {
+    integrate_runs_with(Engine::Auto, runs, settings)
+}
+
+/// [`integrate_runs`] with a given engine.
+pub fn integrate_runs_with<R: LaneRun<DIM>, const DIM: usize>(
+    engine: Engine,
+    runs: &[R],
+    settings: &LaneSettings,
+) -> Vec<LaneOutcome<DIM>> {
+    run_engine(engine, runs, settings, None)
+}
+
+/// [`integrate_runs`], handing every accepted step of every run to `observe(run, step)` (the
+/// run's index in `runs`), with what `grid` asks at its output grid; when it returns false,
+/// the run ends there with [`LaneStatus::Ended`].
+pub fn integrate_runs_observed<R: LaneRun<DIM>, const DIM: usize>(
+    runs: &[R],
+    settings: &LaneSettings,
+    grid: GridObservation,
+    observe: Observer<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    run_engine(Engine::Auto, runs, settings, Some((grid, observe)))
+}
+
+/// [`integrate_runs_observed`] with a given engine.
+pub fn integrate_runs_observed_with<R: LaneRun<DIM>, const DIM: usize>(
+    engine: Engine,
+    runs: &[R],
+    settings: &LaneSettings,
+    grid: GridObservation,
+    observe: Observer<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    run_engine(engine, runs, settings, Some((grid, observe)))
+}
+
+/// An observer and what it reads at the output grid.
+type Observing<'o, const DIM: usize> = Option<(GridObservation, Observer<'o, DIM>)>;
+
+/// The engine actually run for `engine` on this processor.
+pub fn resolved(engine: Engine) -> Engine {
+    use crate::cpu::{avx2_available, avx512_available};
+    match engine {
+        Engine::Auto | Engine::Avx512 if avx512_available() => Engine::Avx512,
+        Engine::Auto | Engine::Avx512 | Engine::Avx2 if avx2_available() => Engine::Avx2,
+        Engine::Auto | Engine::Avx512 | Engine::Avx2 => Engine::Scalar,
+        e => e,
+    }
+}
+
+fn run_engine<R: LaneRun<DIM>, const DIM: usize>(
+    engine: Engine,
+    runs: &[R],
+    settings: &LaneSettings,
+    observe: Observing<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    match resolved(engine) {
+        Engine::Portable4 => lockstep::<F64x4, R, DIM>(runs, settings, observe),
+        #[cfg(target_arch = "x86_64")]
+        Engine::Avx2 => {
+            // SAFETY: `resolved` chose AVX2 only where the processor has it.
+            unsafe { lockstep_avx2(runs, settings, observe) }
+        }
+        #[cfg(target_arch = "x86_64")]
+        Engine::Avx512 => {
+            // SAFETY: `resolved` chose AVX-512F only where the processor has it.
+            unsafe { lockstep_avx512(runs, settings, observe) }
+        }
+        _ => lockstep::<f64, R, DIM>(runs, settings, observe),
+    }
+}
+
+/// [`lockstep`] at four lanes, compiled for AVX2 (everything below is inlined into it). No
+/// `mul_add` is written and FMA is not enabled, so nothing is fused: the bits are the scalar
+/// path's.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn lockstep_avx2<R: LaneRun<DIM>, const DIM: usize>(
+    runs: &[R],
+    settings: &LaneSettings,
+    observe: Observing<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    lockstep::<F64x4, R, DIM>(runs, settings, observe)
+}
+
+/// [`lockstep`] at eight lanes, compiled for AVX-512F so that the lane type's intrinsics
+/// inline into it: one 512-bit instruction per element-wise operation. Nothing is fused (no
+/// fused intrinsic is called, and Rust contracts nothing): the bits are the scalar path's.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn lockstep_avx512<R: LaneRun<DIM>, const DIM: usize>(
+    runs: &[R],
+    settings: &LaneSettings,
+    observe: Observing<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    lockstep::<super::f64x8::F64x8, R, DIM>(runs, settings, observe)
+}
+
+/// The system as the stages' right-hand side, noting the lanes whose closed form was solved
+/// at every stage.
+struct Solving<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> {
+    system: &'a R::System<L>,
+    solved: L::Mask,
+}
+
+impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> StageRhs<L> for Solving<'_, L, R, DIM> {
+    #[inline(always)]
+    fn eval(&mut self, _t: L, y: &[L], dydt: &mut [L]) {
+        self.solved = self.solved & self.system.rhs(y, dydt);
+    }
+}
+
+/// [`LaneSample`] in lanes, for the lanes of `due`: the nutation angle, and the state and
+/// its whole observation where the grid observation is [`GridObservation::Full`].
+struct SampleLanes<L: Lane, const DIM: usize> {
+    due: L::Mask,
+    t: L,
+    nutation_angle: L,
+    full: Option<([L; DIM], LaneObservation<L>)>,
+}
+
+/// The lanes' integration state: each field holds one value per lane.
+struct Lanes<L: Lane, R: LaneRun<DIM>, const DIM: usize> {
+    system: R::System<L>,
+    /// The shared settings, splat.
+    atol: L,
+    rtol: L,
+    h_max: L,
+    t: L,
+    /// Start of the last accepted step (s), when observed.
+    t_prev: L,
+    t_end: L,
+    /// The controller's proposal (s).
+    h: L,
+    fac_old: L,
+    y: [L; DIM],
+    y_new: [L; DIM],
+    stage: [L; DIM],
+    k: [[L; DIM]; 7],
+    /// The state and the first stage at the start of the last attempted step and its size
+    /// (s), when observed: with the other stages and `y_new`, what its dense output is
+    /// formed of (only where it is read: [`Lanes::sample_inside`], [`LaneRest`]).
+    y_start: [L; DIM],
+    k_start: [L; DIM],
+    h_step: L,
+    /// The observation at the end of the last accepted step, when observed, and the drift
+    /// there from each run's start.
+    end: Option<LaneObservation<L>>,
+    drift: Option<LaneDrift<L>>,
+    /// What each run's drift is measured against (its observation at t = 0), when observed.
+    reference: Option<DriftReference<L>>,
+    /// Each run's output grid (Hz; 0: none) and the index k of its next grid time
+    /// k / rate after the last accepted step's end, when observed.
+    sample_rate: L,
+    next_sample: L,
+    /// The lanes whose last accepted step holds a grid time strictly inside it, with that
+    /// time, the state there and its observation, when observed.
+    sample: Option<SampleLanes<L, DIM>>,
+    /// Work counters, as exact integers in f64.
+    steps: L,
+    rejected: L,
+    rhs_evaluations: L,
+    rejected_in_a_row: L,
+    saw_non_finite: L::Mask,
+    /// Lanes holding a run that is still stepping.
+    running: L::Mask,
+    /// What an observed integration computes at the output grid.
+    grid: GridObservation,
+    /// Lanes that ended in the last phase, with their status, to be collected.
+    ended: Vec<(usize, LaneStatus)>,
+}
+
+impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
+    /// Every lane empty, holding `run`'s values (finite, so that idle lanes compute harmless
+    /// numbers).
+    #[inline(always)]
+    fn new(run: &R, settings: &LaneSettings) -> Self {
+        let z = L::splat(0.0);
+        let mut lanes = Lanes {
+            system: R::System::<L>::idle(),
+            atol: L::splat(settings.tolerances.atol),
+            rtol: L::splat(settings.tolerances.rtol),
+            h_max: L::splat(settings.h_max),
+            t: z,
+            t_prev: z,
+            t_end: z,
+            h: z,
+            fac_old: z,
+            y: [z; DIM],
+            y_new: [z; DIM],
+            stage: [z; DIM],
+            k: [[z; DIM]; 7],
+            y_start: [z; DIM],
+            k_start: [z; DIM],
+            h_step: z,
+            end: None,
+            drift: None,
+            reference: None,
+            sample_rate: z,
+            next_sample: z,
+            sample: None,
+            steps: z,
+            rejected: z,
+            rhs_evaluations: z,
+            rejected_in_a_row: z,
+            saw_non_finite: L::Mask::splat(false),
+            running: L::Mask::splat(false),
+            grid: GridObservation::Full,
+            ended: Vec::with_capacity(L::WIDTH),
+        };
+        for i in 0..L::WIDTH {
+            lanes.load(i, run);
+        }
+        lanes.running = L::Mask::splat(false);
+        lanes
+    }
+
+    /// Puts `run` into lane `i`, at its start.
+    #[inline(always)]
+    fn load(&mut self, i: usize, run: &R) {
+        let set = |x: &mut L, v: f64| *x = x.with_lane(i, v);
+        self.system.load(i, run);
+        for (j, &v) in run.initial_state().iter().enumerate() {
+            set(&mut self.y[j], v);
+        }
+        set(&mut self.t, 0.0);
+        set(&mut self.t_end, run.t_end());
+        // Finite and non-negative, or no grid.
+        let rate = run.sample_rate();
+        let rate = if rate > 0.0 && rate.is_finite() {
+            rate
+        } else {
+            0.0
+        };
+        set(&mut self.sample_rate, rate);
+        // The monitor samples t = 0 itself at the start.
+        set(&mut self.next_sample, 1.0);
+        set(&mut self.h, 0.0);
+        set(&mut self.fac_old, 1e-4);
+        set(&mut self.steps, 0.0);
+        set(&mut self.rejected, 0.0);
+        set(&mut self.rhs_evaluations, 0.0);
+        set(&mut self.rejected_in_a_row, 0.0);
+        self.saw_non_finite = self.saw_non_finite.with_lane(i, false);
+        self.running = self.running.with_lane(i, true);
+    }
+
+    /// Lane `i`'s outcome with `status`.
+    fn outcome(&self, i: usize, status: LaneStatus) -> LaneOutcome<DIM> {
+        LaneOutcome {
+            status,
+            t: self.t.lane(i),
+            y: std::array::from_fn(|j| self.y[j].lane(i)),
+            stats: Stats {
+                steps: self.steps.lane(i) as u64,
+                rejected_steps: self.rejected.lane(i) as u64,
+                rhs_evaluations: self.rhs_evaluations.lane(i) as u64,
+                ..Stats::default()
+            },
+        }
+    }
+
+    /// The last attempted step's stages as its dense output reads them: its first stage as
+    /// it was at the step's start (`k[0]` holds the next step's once the step is accepted).
+    #[inline(always)]
+    fn step_stages(&self) -> [&[L; DIM]; 7] {
+        let [_, k2, k3, k4, k5, k6, k7] = &self.k;
+        [&self.k_start, k2, k3, k4, k5, k6, k7]
+    }
+
+    /// Lane `i`'s last accepted step (of an observed integration), into `step`: the numbers
+    /// read at every step, the rest left in the lanes ([`LaneRest`]).
+    #[inline(always)]
+    fn step_of(&self, i: usize, step: &mut LaneStep) {
+        step.t_prev = read(&self.t_prev, i);
+        step.t = read(&self.t, i);
+        step.finite = self.y.iter().all(|y| read(y, i).is_finite());
+        if let Some(e) = &self.end {
+            step.end_nutation_angle = read(&e.nutation_angle, i);
+            step.end_kinetic_energy = read(&e.kinetic_energy, i);
+        }
+        if let Some(d) = &self.drift {
+            step.drift = d.lane(i);
+        }
+        step.sample = match &self.sample {
+            Some(SampleLanes {
+                due,
+                t,
+                nutation_angle,
+                ..
+            }) if due.test(i) => Some(GridAngle {
+                t: read(t, i),
+                nutation_angle: read(nutation_angle, i),
+            }),
+            _ => None,
+        };
+        step.stats = Stats {
+            steps: read(&self.steps, i) as u64,
+            rejected_steps: read(&self.rejected, i) as u64,
+            rhs_evaluations: read(&self.rhs_evaluations, i) as u64,
+            ..Stats::default()
+        };
+    }
+
+    /// Ends lane `i`'s run as [`LaneStatus::Ended`], whether it was still running or had just
+    /// ended (reaching its end time) in the last attempt.
+    #[cold]
+    #[inline(never)]
+    fn end_observed(&mut self, i: usize) {
+        if self.running.test(i) {
+            self.end(L::Mask::splat(false).with_lane(i, true), |_, _| {
+                LaneStatus::Ended
+            });
+        } else if let Some(e) = self.ended.iter_mut().find(|e| e.0 == i) {
+            e.1 = LaneStatus::Ended;
+        }
+    }
+
+    /// Ends the runs of the lanes in `mask` with the status `status(i)` (kept until collected).
+    #[cold]
+    #[inline(never)]
+    fn end(&mut self, mask: L::Mask, status: impl Fn(&Self, usize) -> LaneStatus) {
+        for i in 0..L::WIDTH {
+            if mask.test(i) {
+                let s = status(self, i);
+                self.ended.push((i, s));
+                self.running = self.running.with_lane(i, false);
+            }
+        }
+    }
+
+    /// The drift reference of the lanes of `starting`, from their state at t = 0 (the run
+    /// monitor's `Reference::of` its first observation).
+    #[inline(always)]
+    fn take_references(&mut self, starting: L::Mask) {
+        let now = self.system.observe(&self.y).drift_reference();
+        self.reference = Some(match self.reference {
+            None => now,
+            Some(was) => DriftReference {
+                h0: L::select(starting, now.h0, was.h0),
+                h_inertial0: linalg::each3(|k| {
+                    L::select(starting, now.h_inertial0[k], was.h_inertial0[k])
+                }),
+                e0: L::select(starting, now.e0, was.e0),
+            },
+        });
+    }
+
+    /// The first stage and the initial step of the lanes of `starting`, as the scalar
+    /// `Dopri5::step` does on its first call.
+    #[inline(always)]
+    fn start(&mut self, starting: L::Mask) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let system = &self.system;
+        let mut first = [zero; DIM];
+        let solved = system.rhs(&self.y, &mut first);
+        self.rhs_evaluations += L::select(starting, one, zero);
+        let mut finite = L::Mask::splat(true);
+        for (j, &f) in first.iter().enumerate() {
+            self.k[0][j] = L::select(starting, f, self.k[0][j]);
+            finite = finite & f.is_finite();
+        }
+        let declined = starting & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+        let non_finite = starting & solved & !finite;
+        if non_finite.any() {
+            self.end(non_finite, |s, i| {
+                LaneStatus::Failed(StepError::NonFiniteDerivative { t: s.t.lane(i) })
+            });
+        }
+        let starting = starting & self.running;
+        let mut rhs = Solving::<L, R, DIM> {
+            system: &self.system,
+            solved: L::Mask::splat(true),
+        };
+        let [k1, k2, ..] = &mut self.k;
+        let h = initial_step(
+            &mut rhs,
+            self.t,
+            &self.y,
+            k1,
+            k2,
+            &mut self.stage,
+            self.atol,
+            self.rtol,
+            self.h_max,
+            self.t_end - self.t,
+        );
+        let solved = rhs.solved;
+        self.rhs_evaluations += L::select(starting, one, zero);
+        self.h = L::select(starting, h, self.h);
+        let declined = starting & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+    }
+
+    /// For the lanes of `accepted` that have just taken a step: the first time of the run's
+    /// output grid strictly inside it, the state there by the step's dense output (the
+    /// operations of `dopri5::dense_value`) and its observation; then the next grid index
+    /// past the step's end, as the run monitor advances it when it samples up to there. A
+    /// grid time at the step's end is the end observation, and a second one inside the same
+    /// step is left to the monitor.
+    #[inline(always)]
+    fn sample_inside(&mut self, accepted: L::Mask) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let gridded = accepted & self.sample_rate.greater_than(zero);
+        let t_k = self.next_sample / self.sample_rate;
+        let due = gridded & t_k.less_than(self.t);
+        self.sample = if due.any() {
+            let mut y = [zero; DIM];
+            // The step's dense output (what the observation does not read of it is dropped).
+            let mut cont = [[zero; DIM]; 5];
+            let k = self.step_stages();
+            dense_coefficients(self.h_step, &k, &self.y_start, &self.y_new, &mut cont);
+            dense_interior(t_k, self.t_prev, self.t, &cont, &mut y);
+            let observation = self.system.observe(&y);
+            Some(SampleLanes {
+                due,
+                t: t_k,
+                nutation_angle: observation.nutation_angle,
+                full: (self.grid == GridObservation::Full).then_some((y, observation)),
+            })
+        } else {
+            None
+        };
+        loop {
+            let passed = gridded & (self.next_sample / self.sample_rate).at_most(self.t);
+            if !passed.any() {
+                break;
+            }
+            self.next_sample += L::select(passed, one, zero);
+        }
+    }
+
+    /// One attempted step in every running lane, accepted or rejected lane by lane, as the
+    /// scalar `Dopri5::step` takes it; returns the lanes that accepted. With `observed`, the
+    /// accepted steps' dense output is kept.
+    #[inline(always)]
+    fn attempt(&mut self, observed: bool) -> L::Mask {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let end = adaptive_step_end(self.t, self.h.min(self.h_max), self.t_end);
+        let underflow = end.underflow & self.running;
+        if underflow.any() {
+            self.end(underflow, |s, i| {
+                let t = s.t.lane(i);
+                LaneStatus::Failed(if s.saw_non_finite.test(i) {
+                    StepError::NonFiniteDerivative { t }
+                } else {
+                    StepError::StepSizeUnderflow {
+                        t,
+                        h: (end.t_new - s.t).lane(i),
+                    }
+                })
+            });
+        }
+        let h = end.h;
+        let mut rhs = Solving::<L, R, DIM> {
+            system: &self.system,
+            solved: L::Mask::splat(true),
+        };
+        stages(
+            &mut rhs,
+            self.t,
+            h,
+            &self.y,
+            &mut self.k,
+            &mut self.stage,
+            &mut self.y_new,
+        );
+        let solved = rhs.solved;
+        self.rhs_evaluations += L::select(self.running, L::splat(6.0), zero);
+        let declined = self.running & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+        let running = self.running;
+        let err = error_norm(h, &self.k, &self.y, &self.y_new, self.atol, self.rtol);
+        let finite = err.is_finite();
+        let fac11 = error_factor(err);
+        let accept = running & finite & err.at_most(one);
+        let reject = running & !accept;
+        let after_rejections = self.rejected_in_a_row.greater_than(zero);
+        let (h_accepted, fac_old) =
+            accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
+        let h_rejected = L::select(
+            finite,
+            rejected_step_size(fac11, h),
+            non_finite_step_size(h),
+        );
+        self.h = L::select(
+            accept,
+            kept_proposal(end.last, self.h, h_accepted),
+            L::select(reject, h_rejected, self.h),
+        );
+        self.fac_old = L::select(accept, fac_old, self.fac_old);
+        if observed {
+            // What the step's dense output is formed of where it is read (for every lane;
+            // the others' are not read).
+            self.y_start = self.y;
+            self.k_start = self.k[0];
+            self.h_step = h;
+            self.t_prev = L::select(accept, self.t, self.t_prev);
+        }
+        for j in 0..DIM {
+            self.y[j] = L::select(accept, self.y_new[j], self.y[j]);
+            // First same as last: the last stage is f at the new point.
+            self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
+        }
+        self.t = L::select(accept, end.t_new, self.t);
+        if observed && accept.any() {
+            let end = self.system.observe(&self.y);
+            self.drift = self.reference.as_ref().map(|r| end.drift(r));
+            self.end = Some(end);
+            self.sample_inside(accept);
+        }
+        self.steps += L::select(accept, one, zero);
+        self.rejected += L::select(reject, one, zero);
+        self.rejected_in_a_row = L::select(
+            accept,
+            zero,
+            L::select(reject, self.rejected_in_a_row + one, self.rejected_in_a_row),
+        );
+        self.saw_non_finite = (self.saw_non_finite & !accept) | (reject & !finite);
+        let too_many = reject
+            & self
+                .rejected_in_a_row
+                .greater_than(L::splat(f64::from(MAX_REJECTIONS)));
+        if too_many.any() {
+            self.end(too_many, |s, i| {
+                let t = s.t.lane(i);
+                LaneStatus::Failed(if finite.test(i) {
+                    StepError::StepSizeUnderflow { t, h: h.lane(i) }
+                } else {
+                    StepError::NonFiniteDerivative { t }
+                })
+            });
+        }
+        let done = accept & self.t.at_least(self.t_end);
+        if done.any() {
+            self.end(done, |_, _| LaneStatus::Complete);
+        }
+        accept
+    }
+}
+
+/// The lockstep integration of `runs` at lane type `L`; see the module documentation.
+#[inline(always)]
+fn lockstep<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
+    runs: &[R],
+    settings: &LaneSettings,
+    observe: Observing<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
+    let mut outcomes: Vec<Option<LaneOutcome<DIM>>> = vec![None; runs.len()];
+    let Some(first) = runs.first() else {
+        return Vec::new();
+    };
+    let mut lanes = Lanes::<L, R, DIM>::new(first, settings);
+    let mut observe = observe.map(|(grid, observer)| {
+        lanes.grid = grid;
+        observer
+    });
+    let mut held: Vec<Option<usize>> = vec![None; L::WIDTH];
+    let mut next = 0;
+    // The observed lane's step, reused.
+    let mut step = LaneStep::default();
+    loop {
+        // Each free lane takes the next run.
+        let mut starting = L::Mask::splat(false);
+        for (i, slot) in held.iter_mut().enumerate() {
+            while slot.is_none() && next < runs.len() {
+                let (index, run) = (next, &runs[next]);
+                next += 1;
+                let unstarted = |status| LaneOutcome {
+                    status,
+                    t: 0.0,
+                    y: run.initial_state(),
+                    stats: Stats::default(),
+                };
+                if !run.admitted() {
+                    outcomes[index] = Some(unstarted(LaneStatus::Declined { t: 0.0 }));
+                } else if run.t_end().is_nan() || run.t_end() <= 0.0 {
+                    // As the scalar loop `while t < t_end`: no step.
+                    outcomes[index] = Some(unstarted(LaneStatus::Complete));
+                } else {
+                    lanes.load(i, run);
+                    *slot = Some(index);
+                    starting = starting.with_lane(i, true);
+                }
+            }
+        }
+        if held.iter().all(Option::is_none) {
+            break;
+        }
+        if starting.any() {
+            if observe.is_some() {
+                lanes.take_references(starting);
+            }
+            lanes.start(starting);
+        }
+        if lanes.running.any() {
+            let accepted = lanes.attempt(observe.is_some());
+            if let Some(observe) = observe.as_mut() {
+                for (i, slot) in held.iter().enumerate() {
+                    if let Some(index) = *slot
+                        && accepted.test(i)
+                    {
+                        lanes.step_of(i, &mut step);
+                        let rest = LaneRest {
+                            lanes: &lanes,
+                            lane: i,
+                        };
+                        if !observe(index, &step, &rest) {
+                            lanes.end_observed(i);
+                        }
+                    }
+                }
+            }
+        }
+        for (i, status) in std::mem::take(&mut lanes.ended) {
+            if let Some(index) = held[i].take() {
+                outcomes[index] = Some(lanes.outcome(i, status));
+            }
+        }
+    }
+    outcomes
+        .into_iter()
+        .map(|o| o.expect("every run ends"))
+        .collect()
+}
