@@ -30,7 +30,9 @@
 // against the source by eye; the compiler rounds them to the nearest `f64`.
 #![allow(clippy::excessive_precision)]
 
+use super::dopri5::{StageRhs, SystemRhs};
 use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine_on};
+use crate::lanes::Lane;
 
 // Nodes (c₁ = 0, c₁₂ = c₁₃ = 1).
 const C2: f64 = 0.526001519587677318785587544488e-01;
@@ -219,6 +221,409 @@ const BETA: f64 = 0.0;
 const EXPO: f64 = 1.0 / 8.0 - 0.2 * BETA;
 const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
 
+// The step's arithmetic, generic over the lane type: at `f64` it is the scalar `Dop853`'s,
+// at a wider lane one run per lane (crate::lanes). Each function rounds as the scalar method
+// always has, so a lane's numbers are the scalar run's.
+
+/// How a step's stage arguments `base + h·Σⱼ a[j]·k[j]` are formed: by [`combine`] in every
+/// case, through its AVX2 build on the scalar path ([`combine_on`], the same bits), plainly in
+/// lanes.
+pub(crate) trait Combine<L: Lane> {
+    /// `out = base + h·Σⱼ a[j]·k[j]`.
+    fn combine<const M: usize>(&self, out: &mut [L], base: &[L], h: L, a: [f64; M], k: [&[L]; M]);
+}
+
+/// The scalar path's [`Combine`]: [`combine_on`], through its AVX2 build when the field is
+/// true (the processor has AVX2).
+struct ScalarCombine(bool);
+
+impl Combine<f64> for ScalarCombine {
+    #[inline(always)]
+    fn combine<const M: usize>(
+        &self,
+        out: &mut [f64],
+        base: &[f64],
+        h: f64,
+        a: [f64; M],
+        k: [&[f64]; M],
+    ) {
+        combine_on(self.0, out, base, h, a, k)
+    }
+}
+
+/// Starting step (s) by Hairer's `HINIT` (order 8, RMS norms) from `(t, y)` with
+/// `k1 = f(t, y)`, for a span `span` (s) and a cap `h_max` (s); evaluates `rhs` once (into
+/// `k2`, with `stage` as scratch).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn initial_step<L: Lane>(
+    rhs: &mut impl StageRhs<L>,
+    comb: &impl Combine<L>,
+    t: L,
+    y: &[L],
+    k1: &[L],
+    k2: &mut [L],
+    stage: &mut [L],
+    (atol, rtol): (L, L),
+    h_max: L,
+    span: L,
+) -> L {
+    let n = y.len();
+    let (k1, k2, stage) = (&k1[..n], &mut k2[..n], &mut stage[..n]);
+    let c = L::splat;
+    let count = c(n as f64);
+    let sc = |yi: L| atol + rtol * yi.abs();
+    let (mut dny, mut dnf) = (c(0.0), c(0.0));
+    for i in 0..n {
+        let (a, b) = (y[i] / sc(y[i]), k1[i] / sc(y[i]));
+        dny += a * a;
+        dnf += b * b;
+    }
+    let (dny, dnf) = ((dny / count).sqrt(), (dnf / count).sqrt());
+    let tiny = c(1e-10);
+    let h = L::select(
+        dny.less_than(tiny) | dnf.less_than(tiny),
+        c(1e-6),
+        c(0.01) * dny / dnf,
+    );
+    let h = h.min(h_max).min(span);
+    comb.combine(stage, y, h, [1.0], [k1]);
+    rhs.eval(t + h, stage, k2);
+    let mut der2 = c(0.0);
+    for i in 0..n {
+        let a = (k2[i] - k1[i]) / sc(y[i]);
+        der2 += a * a;
+    }
+    let der12 = ((der2 / count).sqrt() / h).max(dnf);
+    let h1 = L::select(
+        der12.at_most(c(1e-15)),
+        (h * c(1e-3)).max(c(1e-6)),
+        (c(0.01) / der12).powf(1.0 / 8.0),
+    );
+    let h = (c(100.0) * h).min(h1).min(h_max).min(span);
+    // Scaled norms can overflow (tiny atol, huge states): fall back to a small step and let
+    // the controller find its way from there.
+    L::select(
+        h.is_finite() & h.greater_than(c(0.0)),
+        h,
+        (c(1e-6) * span).min(h_max),
+    )
+}
+
+/// Evaluates stages 2–12 of a step `h` (s) from `(t, y)` with `k[0] = f(t, y)`, into
+/// `k[1..12]`, with `stage` as scratch.
+#[inline(always)]
+pub(crate) fn stages<L: Lane, K: AsMut<[L]>>(
+    rhs: &mut impl StageRhs<L>,
+    comb: &impl Combine<L>,
+    t: L,
+    h: L,
+    y: &[L],
+    k: &mut [K; 16],
+    stage: &mut [L],
+) {
+    let n = y.len();
+    let [k1, k2, k3, k4, k5, k6, k7, k8, k9, k10, k11, k12, ..] = k;
+    let (k1, k2, k3, k4) = (k1.as_mut(), k2.as_mut(), k3.as_mut(), k4.as_mut());
+    let (k5, k6, k7, k8) = (k5.as_mut(), k6.as_mut(), k7.as_mut(), k8.as_mut());
+    let (k9, k10, k11, k12) = (k9.as_mut(), k10.as_mut(), k11.as_mut(), k12.as_mut());
+    let s = &mut stage[..n];
+    let at = |c: f64| t + L::splat(c) * h;
+    comb.combine(s, y, h, [A2_1], [k1]);
+    rhs.eval(at(C2), s, k2);
+    comb.combine(s, y, h, [A3_1, A3_2], [k1, k2]);
+    rhs.eval(at(C3), s, k3);
+    comb.combine(s, y, h, [A4_1, A4_3], [k1, k3]);
+    rhs.eval(at(C4), s, k4);
+    comb.combine(s, y, h, [A5_1, A5_3, A5_4], [k1, k3, k4]);
+    rhs.eval(at(C5), s, k5);
+    comb.combine(s, y, h, [A6_1, A6_4, A6_5], [k1, k4, k5]);
+    rhs.eval(at(C6), s, k6);
+    comb.combine(s, y, h, [A7_1, A7_4, A7_5, A7_6], [k1, k4, k5, k6]);
+    rhs.eval(at(C7), s, k7);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A8_1, A8_4, A8_5, A8_6, A8_7],
+        [k1, k4, k5, k6, k7],
+    );
+    rhs.eval(at(C8), s, k8);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A9_1, A9_4, A9_5, A9_6, A9_7, A9_8],
+        [k1, k4, k5, k6, k7, k8],
+    );
+    rhs.eval(at(C9), s, k9);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A10_1, A10_4, A10_5, A10_6, A10_7, A10_8, A10_9],
+        [k1, k4, k5, k6, k7, k8, k9],
+    );
+    rhs.eval(at(C10), s, k10);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A11_1, A11_4, A11_5, A11_6, A11_7, A11_8, A11_9, A11_10],
+        [k1, k4, k5, k6, k7, k8, k9, k10],
+    );
+    rhs.eval(at(C11), s, k11);
+    comb.combine(
+        s,
+        y,
+        h,
+        [
+            A12_1, A12_4, A12_5, A12_6, A12_7, A12_8, A12_9, A12_10, A12_11,
+        ],
+        [k1, k4, k5, k6, k7, k8, k9, k10, k11],
+    );
+    rhs.eval(t + h, s, k12);
+}
+
+/// Evaluates the dense-output stages 14–16 of a step `h` (s) from `(t, y)`, its stages 1–12
+/// and `k[12]` = f at its end in place, into `k[13..16]`, with `stage` as scratch.
+#[inline(always)]
+pub(crate) fn dense_stages<L: Lane, K: AsMut<[L]>>(
+    rhs: &mut impl StageRhs<L>,
+    comb: &impl Combine<L>,
+    t: L,
+    h: L,
+    y: &[L],
+    k: &mut [K; 16],
+    stage: &mut [L],
+) {
+    let n = y.len();
+    let [
+        k1,
+        _,
+        _,
+        _,
+        _,
+        k6,
+        k7,
+        k8,
+        k9,
+        k10,
+        k11,
+        k12,
+        k13,
+        k14,
+        k15,
+        k16,
+    ] = k;
+    let (k1, k6, k7, k8) = (k1.as_mut(), k6.as_mut(), k7.as_mut(), k8.as_mut());
+    let (k9, k10, k11, k12) = (k9.as_mut(), k10.as_mut(), k11.as_mut(), k12.as_mut());
+    let (k13, k14, k15, k16) = (k13.as_mut(), k14.as_mut(), k15.as_mut(), k16.as_mut());
+    let s = &mut stage[..n];
+    let at = |c: f64| t + L::splat(c) * h;
+    comb.combine(
+        s,
+        y,
+        h,
+        [A14_1, A14_7, A14_8, A14_9, A14_10, A14_11, A14_12, A14_13],
+        [k1, k7, k8, k9, k10, k11, k12, k13],
+    );
+    rhs.eval(at(C14), s, k14);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A15_1, A15_6, A15_7, A15_8, A15_11, A15_12, A15_13, A15_14],
+        [k1, k6, k7, k8, k11, k12, k13, k14],
+    );
+    rhs.eval(at(C15), s, k15);
+    comb.combine(
+        s,
+        y,
+        h,
+        [A16_1, A16_6, A16_7, A16_8, A16_9, A16_13, A16_14, A16_15],
+        [k1, k6, k7, k8, k9, k13, k14, k15],
+    );
+    rhs.eval(at(C16), s, k16);
+}
+
+/// The eighth-order solution `y_new` of a step `h` from `y` and, per component, its
+/// third- and fifth-order error estimates over the component's scale `atol + rtol·max(|y|,
+/// |y_new|)` (Hairer, §II.10), from `stages` = k₁, k₆ … k₁₂. Element by element, so each
+/// component's arithmetic is the same whichever vector width runs it.
+#[inline(always)]
+pub(crate) fn solution_and_errors<L: Lane>(
+    (h, atol, rtol): (L, L, L),
+    y: &[L],
+    stages: [&[L]; 8],
+    y_new: &mut [L],
+    scaled3: &mut [L],
+    scaled5: &mut [L],
+) {
+    let n = y.len();
+    let [k1, k6, k7, k8, k9, k10, k11, k12] = stages.map(|k| &k[..n]);
+    let (y_new, scaled3, scaled5) = (&mut y_new[..n], &mut scaled3[..n], &mut scaled5[..n]);
+    let c = L::splat;
+    for i in 0..n {
+        let slope = c(B1) * k1[i]
+            + c(B6) * k6[i]
+            + c(B7) * k7[i]
+            + c(B8) * k8[i]
+            + c(B9) * k9[i]
+            + c(B10) * k10[i]
+            + c(B11) * k11[i]
+            + c(B12) * k12[i];
+        y_new[i] = y[i] + h * slope;
+        let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
+        let e3 = slope - c(BHH1) * k1[i] - c(BHH2) * k9[i] - c(BHH3) * k12[i];
+        let e5 = c(ER1) * k1[i]
+            + c(ER6) * k6[i]
+            + c(ER7) * k7[i]
+            + c(ER8) * k8[i]
+            + c(ER9) * k9[i]
+            + c(ER10) * k10[i]
+            + c(ER11) * k11[i]
+            + c(ER12) * k12[i];
+        scaled3[i] = e3 / sk;
+        scaled5[i] = e5 / sk;
+    }
+}
+
+/// The step's error from its components' scaled errors ([`solution_and_errors`]), summed in
+/// order: h·err₅²/√(n (err₅² + 0.01·err₃²)) with RMS norms (Hairer, §II.10). A step is
+/// accepted where it is at most 1; non-finite if the stages were.
+#[inline(always)]
+pub(crate) fn error_estimate<L: Lane>(h: L, scaled3: &[L], scaled5: &[L]) -> L {
+    let c = L::splat;
+    let (mut err5, mut err3) = (c(0.0), c(0.0));
+    for (&e3, &e5) in scaled3.iter().zip(scaled5) {
+        err3 += e3 * e3;
+        err5 += e5 * e5;
+    }
+    let deno = err5 + c(0.01) * err3;
+    let deno = L::select(deno.at_most(c(0.0)), c(1.0), deno);
+    h.abs() * err5 / (c(scaled3.len() as f64) * deno).sqrt()
+}
+
+/// `err^(1/8 − 0.2 β)`, the error's factor in the step-size control (by square roots when
+/// β = 0: a fraction of the cost of `powf`).
+#[inline(always)]
+pub(crate) fn error_factor<L: Lane>(err: L) -> L {
+    if BETA == 0.0 {
+        err.sqrt().sqrt().sqrt()
+    } else {
+        err.powf(EXPO)
+    }
+}
+
+/// After an accepted step `h` (s) with error `err` and its factor `fac11`
+/// ([`error_factor`]): the next step by the PI controller (no longer than `h` where the step
+/// followed rejections) and the new `fac_old`.
+#[inline(always)]
+pub(crate) fn accepted_step_size<L: Lane>(
+    err: L,
+    fac11: L,
+    h: L,
+    fac_old: L,
+    after_rejections: L::Mask,
+) -> (L, L) {
+    let fac = if BETA == 0.0 {
+        fac11
+    } else {
+        fac11 / fac_old.powf(BETA)
+    };
+    let fac = (fac / L::splat(SAFETY)).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+    let h_new = h / fac;
+    let h_new = L::select(after_rejections, h_new.min(h), h_new);
+    (h_new, err.max(L::splat(1e-4)))
+}
+
+/// The next step (s) after a rejected step `h` whose error had factor `fac11`.
+#[inline(always)]
+pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
+    h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
+}
+
+/// The next step (s) after a step `h` whose stages were not finite.
+#[inline(always)]
+pub(crate) fn non_finite_step_size<L: Lane>(h: L) -> L {
+    L::splat(0.1) * h
+}
+
+/// The seventh-order dense-output coefficients of an accepted step `h` (s) from `y` to
+/// `y_new` with stages `k` (1–16, `k[12]` = f at its end), into `cont`.
+#[inline(always)]
+pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
+    h: L,
+    y: &[L],
+    y_new: &[L],
+    k: &[K; 16],
+    cont: &mut [C; 8],
+) {
+    let n = y.len();
+    let y_new = &y_new[..n];
+    let [c0, c1, c2, c3, c4, c5, c6, c7] = cont;
+    let (k1, k13) = (&k[0].as_ref()[..n], &k[12].as_ref()[..n]);
+    let (c0, c1, c2, c3) = (
+        &mut c0.as_mut()[..n],
+        &mut c1.as_mut()[..n],
+        &mut c2.as_mut()[..n],
+        &mut c3.as_mut()[..n],
+    );
+    for i in 0..n {
+        let dy = y_new[i] - y[i];
+        let bspl = h * k1[i] - dy;
+        c0[i] = y[i];
+        c1[i] = dy;
+        c2[i] = bspl;
+        c3[i] = dy - h * k13[i] - bspl;
+    }
+    // Stages 1, 6–16, in the order of the rows D4…D7. One pass for the four rows, so each
+    // stage value is loaded once.
+    let ks: [&[L]; 12] = [0, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15].map(|j| &k[j].as_ref()[..n]);
+    let (c4, c5, c6, c7) = (
+        &mut c4.as_mut()[..n],
+        &mut c5.as_mut()[..n],
+        &mut c6.as_mut()[..n],
+        &mut c7.as_mut()[..n],
+    );
+    let c = L::splat;
+    for i in 0..n {
+        let (mut s4, mut s5, mut s6, mut s7) = (c(0.0), c(0.0), c(0.0), c(0.0));
+        for j in 0..12 {
+            let v = ks[j][i];
+            s4 += c(D4[j]) * v;
+            s5 += c(D5[j]) * v;
+            s6 += c(D6[j]) * v;
+            s7 += c(D7[j]) * v;
+        }
+        c4[i] = h * s4;
+        c5[i] = h * s5;
+        c6[i] = h * s6;
+        c7[i] = h * s7;
+    }
+}
+
+/// The dense output at `t` (s) strictly inside the accepted step from `t_prev` to `t_now`,
+/// from its coefficients `cont` ([`dense_coefficients`]), into `out`.
+#[inline(always)]
+pub(crate) fn dense_interior<L: Lane, C: AsRef<[L]>>(
+    t: L,
+    t_prev: L,
+    t_now: L,
+    cont: &[C; 8],
+    out: &mut [L],
+) {
+    let n = out.len();
+    let s = (t - t_prev) / (t_now - t_prev);
+    let s1 = L::splat(1.0) - s;
+    let [c0, c1, c2, c3, c4, c5, c6, c7] = cont.each_ref().map(|c| &c.as_ref()[..n]);
+    for i in 0..n {
+        let conpar = c4[i] + s * (c5[i] + s1 * (c6[i] + s * c7[i]));
+        out[i] = c0[i] + s * (c1[i] + s1 * (c2[i] + s * (c3[i] + s1 * conpar)));
+    }
+}
+
 /// When [`Dop853`] evaluates the dense-output stages of an accepted step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum DenseOutput {
@@ -331,127 +736,49 @@ impl Dop853 {
     /// Starting step by Hairer's `HINIT` (order 8), with RMS norms; `k[0]` holds f(t, y).
     /// Costs one right-hand-side evaluation.
     fn initial_step<S: OdeSystem + ?Sized>(&mut self, sys: &S, span: f64) -> f64 {
-        let n = self.y.len();
-        let sc = |y: f64| self.tol.atol + self.tol.rtol * y.abs();
-        let (mut dny, mut dnf) = (0.0, 0.0);
-        for (&y, &f) in self.y.iter().zip(&self.k[0]) {
-            dny += (y / sc(y)).powi(2);
-            dnf += (f / sc(y)).powi(2);
-        }
-        let (dny, dnf) = ((dny / n as f64).sqrt(), (dnf / n as f64).sqrt());
-        let mut h = if dny < 1e-10 || dnf < 1e-10 {
-            1e-6
-        } else {
-            0.01 * dny / dnf
-        };
-        h = h.min(self.h_max).min(span);
-        combine_on(self.avx2, &mut self.stage, &self.y, h, [1.0], [&self.k[0]]);
-        sys.rhs(self.t + h, &self.stage, &mut self.k[1]);
+        let [k1, k2, ..] = &mut self.k;
+        let h = initial_step(
+            &mut SystemRhs(sys),
+            &ScalarCombine(self.avx2),
+            self.t,
+            &self.y,
+            k1,
+            k2,
+            &mut self.stage,
+            (self.tol.atol, self.tol.rtol),
+            self.h_max,
+            span,
+        );
         self.stats.rhs_evaluations += 1;
-        let mut der2 = 0.0;
-        for i in 0..n {
-            der2 += ((self.k[1][i] - self.k[0][i]) / sc(self.y[i])).powi(2);
-        }
-        let der12 = ((der2 / n as f64).sqrt() / h).max(dnf);
-        let h1 = if der12 <= 1e-15 {
-            (h * 1e-3).max(1e-6)
-        } else {
-            (0.01 / der12).powf(1.0 / 8.0)
-        };
-        let h = (100.0 * h).min(h1).min(self.h_max).min(span);
-        // Scaled norms can overflow (tiny atol, huge states): fall back to a small step and
-        // let the controller find its way from there.
-        if h.is_finite() && h > 0.0 {
-            h
-        } else {
-            (1e-6 * span).min(self.h_max)
-        }
+        h
     }
 
     /// Evaluates stages 2–12 for step `h` from `(t, y)` with `k[0] = f(t, y)`, writes the
     /// eighth-order solution to `y_new`, and returns the scaled error estimate of the step
     /// (≤ 1 to accept; non-finite if the stages were).
     fn attempt<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> f64 {
-        let (t, avx2) = (self.t, self.avx2);
         let n = self.y.len();
-        let (y, s, k) = (&self.y[..], &mut self.stage[..], &mut self.k);
-        combine_on(avx2, s, y, h, [A2_1], [&k[0]]);
-        sys.rhs(t + C2 * h, s, &mut k[1]);
-        combine_on(avx2, s, y, h, [A3_1, A3_2], [&k[0], &k[1]]);
-        sys.rhs(t + C3 * h, s, &mut k[2]);
-        combine_on(avx2, s, y, h, [A4_1, A4_3], [&k[0], &k[2]]);
-        sys.rhs(t + C4 * h, s, &mut k[3]);
-        combine_on(avx2, s, y, h, [A5_1, A5_3, A5_4], [&k[0], &k[2], &k[3]]);
-        sys.rhs(t + C5 * h, s, &mut k[4]);
-        combine_on(avx2, s, y, h, [A6_1, A6_4, A6_5], [&k[0], &k[3], &k[4]]);
-        sys.rhs(t + C6 * h, s, &mut k[5]);
-        combine_on(
-            avx2,
-            s,
-            y,
+        let combine = ScalarCombine(self.avx2);
+        stages(
+            &mut SystemRhs(sys),
+            &combine,
+            self.t,
             h,
-            [A7_1, A7_4, A7_5, A7_6],
-            [&k[0], &k[3], &k[4], &k[5]],
+            &self.y,
+            &mut self.k,
+            &mut self.stage,
         );
-        sys.rhs(t + C7 * h, s, &mut k[6]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A8_1, A8_4, A8_5, A8_6, A8_7],
-            [&k[0], &k[3], &k[4], &k[5], &k[6]],
-        );
-        sys.rhs(t + C8 * h, s, &mut k[7]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A9_1, A9_4, A9_5, A9_6, A9_7, A9_8],
-            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7]],
-        );
-        sys.rhs(t + C9 * h, s, &mut k[8]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A10_1, A10_4, A10_5, A10_6, A10_7, A10_8, A10_9],
-            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8]],
-        );
-        sys.rhs(t + C10 * h, s, &mut k[9]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A11_1, A11_4, A11_5, A11_6, A11_7, A11_8, A11_9, A11_10],
-            [&k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8], &k[9]],
-        );
-        sys.rhs(t + C11 * h, s, &mut k[10]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [
-                A12_1, A12_4, A12_5, A12_6, A12_7, A12_8, A12_9, A12_10, A12_11,
-            ],
-            [
-                &k[0], &k[3], &k[4], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10],
-            ],
-        );
-        sys.rhs(t + h, s, &mut k[11]);
         self.stats.rhs_evaluations += 11;
 
         // New state and both error estimates: the element-wise part first (in vector
         // instructions), then the two sums in order.
-        let stages = [&k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11]];
+        let k = &self.k;
+        let stages = [0, 5, 6, 7, 8, 9, 10, 11].map(|j| &k[j][..]);
         let (scaled3, scaled5) = self.scaled_errors.split_at_mut(n);
         let arguments = (h, self.tol.atol, self.tol.rtol);
+        let y = &self.y[..];
         #[cfg(target_arch = "x86_64")]
-        if avx2 {
+        if self.avx2 {
             // SAFETY: `avx2` is true only where the processor has AVX2.
             unsafe {
                 solution_and_errors_avx2(arguments, y, stages, &mut self.y_new, scaled3, scaled5)
@@ -461,17 +788,7 @@ impl Dop853 {
         }
         #[cfg(not(target_arch = "x86_64"))]
         solution_and_errors(arguments, y, stages, &mut self.y_new, scaled3, scaled5);
-        let (mut err5, mut err3) = (0.0, 0.0);
-        for (e3, e5) in scaled3.iter().zip(scaled5.iter()) {
-            err3 += e3.powi(2);
-            err5 += e5.powi(2);
-        }
-        // h·err₅²/√(err₅² + 0.01·err₃²) with RMS norms (Hairer, §II.10).
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        h.abs() * err5 / (n as f64 * deno).sqrt()
+        error_estimate(h, scaled3, scaled5)
     }
 
     /// For a step that passed the error test: evaluates stage 13 = f(t + h, y_new) (the next
@@ -493,127 +810,24 @@ impl Dop853 {
     /// Evaluates the dense-output stages 14–16 of the step `h` from `y` (`k[0]` its first
     /// stage, `k[12]` f at its end). Returns whether they are finite.
     fn dense_stages<S: OdeSystem + ?Sized>(&mut self, sys: &S, h: f64) -> bool {
-        let all_finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-        let (t, y, s, k) = (self.t, &self.y[..], &mut self.stage[..], &mut self.k);
-        let avx2 = self.avx2;
-        combine_on(
-            avx2,
-            s,
-            y,
+        dense_stages(
+            &mut SystemRhs(sys),
+            &ScalarCombine(self.avx2),
+            self.t,
             h,
-            [A14_1, A14_7, A14_8, A14_9, A14_10, A14_11, A14_12, A14_13],
-            [&k[0], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11], &k[12]],
+            &self.y,
+            &mut self.k,
+            &mut self.stage,
         );
-        sys.rhs(t + C14 * h, s, &mut k[13]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A15_1, A15_6, A15_7, A15_8, A15_11, A15_12, A15_13, A15_14],
-            [&k[0], &k[5], &k[6], &k[7], &k[10], &k[11], &k[12], &k[13]],
-        );
-        sys.rhs(t + C15 * h, s, &mut k[14]);
-        combine_on(
-            avx2,
-            s,
-            y,
-            h,
-            [A16_1, A16_6, A16_7, A16_8, A16_9, A16_13, A16_14, A16_15],
-            [&k[0], &k[5], &k[6], &k[7], &k[8], &k[12], &k[13], &k[14]],
-        );
-        sys.rhs(t + C16 * h, s, &mut k[15]);
         self.stats.rhs_evaluations += 3;
-        k[13..16].iter().all(|v| all_finite(v))
+        self.k[13..16]
+            .iter()
+            .all(|v| v.iter().all(|x| x.is_finite()))
     }
 
     /// Fills `cont` for the accepted step `h` from `y` to `y_new` (before they are swapped).
     fn store_dense_output(&mut self, h: f64) {
-        let n = self.y.len();
-        let (y, y_new, k) = (&self.y[..n], &self.y_new[..n], &self.k);
-        let [c0, c1, c2, c3, c4, c5, c6, c7] = &mut self.cont;
-        let (k1, k13) = (&k[0][..n], &k[12][..n]);
-        let (c0, c1, c2, c3) = (&mut c0[..n], &mut c1[..n], &mut c2[..n], &mut c3[..n]);
-        for i in 0..n {
-            let dy = y_new[i] - y[i];
-            let bspl = h * k1[i] - dy;
-            c0[i] = y[i];
-            c1[i] = dy;
-            c2[i] = bspl;
-            c3[i] = dy - h * k13[i] - bspl;
-        }
-        // Stages 1, 6–16, in the order of the rows D4…D7. One pass for the four rows, so
-        // each stage value is loaded once.
-        let ks: [&[f64]; 12] = [
-            &k[0][..n],
-            &k[5][..n],
-            &k[6][..n],
-            &k[7][..n],
-            &k[8][..n],
-            &k[9][..n],
-            &k[10][..n],
-            &k[11][..n],
-            &k[12][..n],
-            &k[13][..n],
-            &k[14][..n],
-            &k[15][..n],
-        ];
-        let (c4, c5, c6, c7) = (&mut c4[..n], &mut c5[..n], &mut c6[..n], &mut c7[..n]);
-        for i in 0..n {
-            let (mut s4, mut s5, mut s6, mut s7) = (0.0, 0.0, 0.0, 0.0);
-            for j in 0..12 {
-                let v = ks[j][i];
-                s4 += D4[j] * v;
-                s5 += D5[j] * v;
-                s6 += D6[j] * v;
-                s7 += D7[j] * v;
-            }
-            c4[i] = h * s4;
-            c5[i] = h * s5;
-            c6[i] = h * s6;
-            c7[i] = h * s7;
-        }
-    }
-}
-
-/// The eighth-order solution `y_new` of a step `h` from `y` and, per component, its
-/// third- and fifth-order error estimates over the component's scale `atol + rtol·max(|y|,
-/// |y_new|)` (Hairer, §II.10), from `stages` = k₁, k₆ … k₁₂. Element by element, so each
-/// component's arithmetic is the same whichever vector width runs it.
-#[inline(always)]
-fn solution_and_errors(
-    (h, atol, rtol): (f64, f64, f64),
-    y: &[f64],
-    stages: [&Vec<f64>; 8],
-    y_new: &mut [f64],
-    scaled3: &mut [f64],
-    scaled5: &mut [f64],
-) {
-    let n = y.len();
-    let [k1, k6, k7, k8, k9, k10, k11, k12] = stages.map(|k| &k[..n]);
-    let (y_new, scaled3, scaled5) = (&mut y_new[..n], &mut scaled3[..n], &mut scaled5[..n]);
-    for i in 0..n {
-        let slope = B1 * k1[i]
-            + B6 * k6[i]
-            + B7 * k7[i]
-            + B8 * k8[i]
-            + B9 * k9[i]
-            + B10 * k10[i]
-            + B11 * k11[i]
-            + B12 * k12[i];
-        y_new[i] = y[i] + h * slope;
-        let sk = atol + rtol * y[i].abs().max(y_new[i].abs());
-        let e3 = slope - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
-        let e5 = ER1 * k1[i]
-            + ER6 * k6[i]
-            + ER7 * k7[i]
-            + ER8 * k8[i]
-            + ER9 * k9[i]
-            + ER10 * k10[i]
-            + ER11 * k11[i]
-            + ER12 * k12[i];
-        scaled3[i] = e3 / sk;
-        scaled5[i] = e5 / sk;
+        dense_coefficients(h, &self.y, &self.y_new, &self.k, &mut self.cont);
     }
 }
 
@@ -623,7 +837,7 @@ fn solution_and_errors(
 fn solution_and_errors_avx2(
     arguments: (f64, f64, f64),
     y: &[f64],
-    stages: [&Vec<f64>; 8],
+    stages: [&[f64]; 8],
     y_new: &mut [f64],
     scaled3: &mut [f64],
     scaled5: &mut [f64],
@@ -683,32 +897,19 @@ impl Stepper for Dop853 {
             if !finite {
                 saw_non_finite = true;
                 self.stats.rejected_steps += 1;
-                self.h = 0.1 * h;
+                self.h = non_finite_step_size(h);
                 rejected_in_a_row += 1;
                 if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                     return Err(StepError::NonFiniteDerivative { t: self.t });
                 }
                 continue;
             }
-            // err^(1/8) by square roots when BETA = 0: a fraction of the cost of `powf`.
-            let fac11 = if BETA == 0.0 {
-                err.sqrt().sqrt().sqrt()
-            } else {
-                err.powf(EXPO)
-            };
+            let fac11 = error_factor(err);
             if err <= 1.0 {
                 // Accepted: (PI) controller for the next step.
-                let mut fac = if BETA == 0.0 {
-                    fac11
-                } else {
-                    fac11 / self.fac_old.powf(BETA)
-                };
-                fac = (fac / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                let mut h_new = h / fac;
-                if rejected_in_a_row > 0 {
-                    h_new = h_new.min(h);
-                }
-                self.fac_old = err.max(1e-4);
+                let (h_new, fac_old) =
+                    accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
+                self.fac_old = fac_old;
                 if self.dense == DenseOutput::Eager {
                     self.store_dense_output(h);
                 } else {
@@ -730,7 +931,7 @@ impl Stepper for Dop853 {
             if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                 return Err(StepError::StepSizeUnderflow { t: self.t, h });
             }
-            self.h = h / (1.0 / FAC_MIN).min(fac11 / SAFETY);
+            self.h = rejected_step_size(fac11, h);
         }
     }
 
@@ -782,16 +983,7 @@ impl Stepper for Dop853 {
             "Dop853::interpolate inside a step needs dense output, which was switched off \
              (or, lazy, not prepared by `prepare_interpolation`)"
         );
-        let s = (t - self.t_prev) / h;
-        let s1 = 1.0 - s;
-        let n = out.len();
-        let [c0, c1, c2, c3, c4, c5, c6, c7] = &self.cont;
-        let (c0, c1, c2, c3) = (&c0[..n], &c1[..n], &c2[..n], &c3[..n]);
-        let (c4, c5, c6, c7) = (&c4[..n], &c5[..n], &c6[..n], &c7[..n]);
-        for i in 0..n {
-            let conpar = c4[i] + s * (c5[i] + s1 * (c6[i] + s * c7[i]));
-            out[i] = c0[i] + s * (c1[i] + s1 * (c2[i] + s * (c3[i] + s1 * conpar)));
-        }
+        dense_interior(t, self.t_prev, self.t, &self.cont, out);
     }
 }
 
@@ -1347,5 +1539,163 @@ mod tests {
         s.interpolate(s.t(), &mut out);
         assert_eq!(out, s.y());
         s.interpolate(0.5 * s.t(), &mut out);
+    }
+
+    /// A rigid body's Euler equations over any lane type: at `f64` the scalar system.
+    struct LaneBody([f64; 3]);
+
+    impl LaneBody {
+        fn eval<L: Lane>(&self, w: &[L], d: &mut [L]) {
+            let i = self.0.map(L::splat);
+            let l = [i[0] * w[0], i[1] * w[1], i[2] * w[2]];
+            d[0] = (l[1] * w[2] - l[2] * w[1]) / i[0];
+            d[1] = (l[2] * w[0] - l[0] * w[2]) / i[1];
+            d[2] = (l[0] * w[1] - l[1] * w[0]) / i[2];
+        }
+    }
+
+    impl OdeSystem for LaneBody {
+        fn dim(&self) -> usize {
+            3
+        }
+        fn rhs(&self, _t: f64, w: &[f64], d: &mut [f64]) {
+            self.eval(w, d);
+        }
+    }
+
+    impl StageRhs<crate::lanes::F64x4> for &LaneBody {
+        fn eval(
+            &mut self,
+            _t: crate::lanes::F64x4,
+            w: &[crate::lanes::F64x4],
+            d: &mut [crate::lanes::F64x4],
+        ) {
+            LaneBody::eval(self, w, d);
+        }
+    }
+
+    /// The lanes' way of forming stage arguments: `combine` itself.
+    struct LaneCombine;
+
+    impl<L: Lane> Combine<L> for LaneCombine {
+        fn combine<const M: usize>(
+            &self,
+            out: &mut [L],
+            base: &[L],
+            h: L,
+            a: [f64; M],
+            k: [&[L]; M],
+        ) {
+            super::super::combine::<L, M>(out, base, h, a, k)
+        }
+    }
+
+    #[test]
+    fn a_first_step_in_four_lanes_is_each_runs_scalar_step_bit_for_bit() {
+        use crate::lanes::{F64x4, LaneMask};
+        let body = LaneBody([1.0, 2.0, 3.0]);
+        let starts = [
+            [1.0, 0.2, -0.5],
+            [0.3, -1.1, 0.05],
+            [-0.7, 0.4, 0.9],
+            [2.0, 0.01, 0.3],
+        ];
+        let tol = Tolerances {
+            rtol: 1e-9,
+            atol: 1e-12,
+        };
+        let t_end = 10.0;
+        // The scalar runs' first steps, and their interpolants at a third of the step.
+        let scalar: Vec<_> = starts
+            .iter()
+            .map(|y0| {
+                let mut d = Dop853::new(0.0, y0, tol, f64::INFINITY, None);
+                d.step(&body, t_end).unwrap();
+                let t_third = d.t_prev() + (d.t() - d.t_prev()) / 3.0;
+                let mut third = [0.0; 3];
+                d.interpolate(t_third, &mut third);
+                (d.clone(), t_third, third)
+            })
+            .collect();
+        for (d, _, _) in &scalar {
+            // A first attempt the error test passes: the step compared is that attempt.
+            assert_eq!(d.stats().rejected_steps, 0);
+        }
+        // The same in four lanes.
+        let lane = |f: &dyn Fn(usize) -> f64| {
+            F64x4::splat(0.0)
+                .with_lane(0, f(0))
+                .with_lane(1, f(1))
+                .with_lane(2, f(2))
+                .with_lane(3, f(3))
+        };
+        let y: [F64x4; 3] = std::array::from_fn(|j| lane(&|i| starts[i][j]));
+        let zero = F64x4::splat(0.0);
+        let mut k = [[zero; 3]; 16];
+        let mut stage = [zero; 3];
+        let mut y_new = [zero; 3];
+        let (mut scaled3, mut scaled5) = ([zero; 3], [zero; 3]);
+        let (atol, rtol) = (F64x4::splat(tol.atol), F64x4::splat(tol.rtol));
+        let mut rhs = &body;
+        body.eval(&y, &mut k[0]);
+        let [k1, k2, ..] = &mut k;
+        let h = initial_step(
+            &mut rhs,
+            &LaneCombine,
+            zero,
+            &y,
+            k1,
+            k2,
+            &mut stage,
+            (atol, rtol),
+            F64x4::splat(f64::INFINITY),
+            F64x4::splat(t_end),
+        );
+        stages(&mut rhs, &LaneCombine, zero, h, &y, &mut k, &mut stage);
+        let stage_values = [0, 5, 6, 7, 8, 9, 10, 11].map(|j| &k[j][..]);
+        solution_and_errors(
+            (h, atol, rtol),
+            &y,
+            stage_values,
+            &mut y_new,
+            &mut scaled3,
+            &mut scaled5,
+        );
+        let err = error_estimate(h, &scaled3, &scaled5);
+        body.eval(&y_new, &mut k[12]);
+        dense_stages(&mut rhs, &LaneCombine, zero, h, &y, &mut k, &mut stage);
+        let mut cont = [[zero; 3]; 8];
+        dense_coefficients(h, &y, &y_new, &k, &mut cont);
+        let t_third = lane(&|i| scalar[i].1);
+        let mut third = [zero; 3];
+        dense_interior(t_third, zero, h, &cont, &mut third);
+        let (h_next, _) = accepted_step_size(
+            err,
+            error_factor(err),
+            h,
+            F64x4::splat(1e-4),
+            <F64x4 as Lane>::Mask::splat(false),
+        );
+        for (i, (d, _, scalar_third)) in scalar.iter().enumerate() {
+            assert!(err.lane(i) <= 1.0);
+            assert_eq!(h.lane(i).to_bits(), d.t().to_bits(), "lane {i}: step");
+            for j in 0..3 {
+                assert_eq!(
+                    y_new[j].lane(i).to_bits(),
+                    d.y()[j].to_bits(),
+                    "lane {i}: y[{j}]"
+                );
+                assert_eq!(
+                    third[j].lane(i).to_bits(),
+                    scalar_third[j].to_bits(),
+                    "lane {i}: interpolant[{j}]"
+                );
+            }
+            assert_eq!(
+                h_next.lane(i).to_bits(),
+                d.proposed_step().to_bits(),
+                "lane {i}: next step"
+            );
+        }
     }
 }

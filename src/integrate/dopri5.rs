@@ -154,7 +154,7 @@ pub(crate) trait StageRhs<L: Lane> {
 
 /// An [`OdeSystem`] as the scalar stages' right-hand side (inlined into them, as the system's
 /// `rhs` was before the stages were generic).
-struct SystemRhs<'a, S: ?Sized>(&'a S);
+pub(crate) struct SystemRhs<'a, S: ?Sized>(pub(crate) &'a S);
 
 impl<S: OdeSystem + ?Sized> StageRhs<f64> for SystemRhs<'_, S> {
     #[inline(always)]
