@@ -1,5 +1,7 @@
 //! The command line as a user meets it: bad input, the run and its outputs, linearize, Ctrl-C.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -7,12 +9,9 @@ fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-cli", name)
 }
 
 fn stderr(o: &Output) -> String {

@@ -2,13 +2,15 @@
 //! telemetry, bit for bit, as the same run written as a scenario file and loaded by the YAML
 //! front end: the typed API and the loader are two doors to one run loop.
 
+mod common;
+
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use polhode::effectors::energy_sink::EnergySink;
 use polhode::log::{McapLogger, charts};
 use polhode::model::{RigidBody, Spacecraft};
 use polhode::scenario::{self, Overrides, Scenario};
 use polhode::sim::{self, Adaptive, Condition, Control, Method, Quantity, Simulation};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const YAML: &str = "\
 name: sink in code
@@ -26,11 +28,9 @@ events:
   - {nutation_angle_deg: {above: 80.0}}
 ";
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-code-log-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch() -> common::Scratch {
+    common::Scratch::new("polhode-code-log", "log")
 }
 
 fn log(scene: &Scenario, path: &Path) -> charts::RunLog {

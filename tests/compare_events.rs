@@ -1,6 +1,8 @@
 //! `polhode compare`'s event columns: the scenarios' own `events:` (their union), the
 //! `--event` override, the 45°/80° fallback, and times identical to `polhode run`'s.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -8,11 +10,9 @@ fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-cmp-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-cmp", name)
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

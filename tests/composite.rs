@@ -7,10 +7,12 @@
 //! the same. Also: placement is checked against `body.shape` only, and without it the run
 //! says what is missing.
 
+mod common;
+
 use nalgebra::{Matrix3, Vector3};
 use polhode::scenario::{self, Overrides, Scenario, ScenarioError};
 use polhode::sim::{self, Control, EventRecord, Reference, Sink};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 use std::sync::atomic::AtomicBool;
 
@@ -424,10 +426,9 @@ fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-composite-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-composite", name)
 }
 
 #[test]

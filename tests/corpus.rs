@@ -7,6 +7,7 @@
 //! generated here. With `POLHODE_RELIABILITY_DIR` set, the observed outcome of every case is
 //! written there for docs/reliability.md (`scripts/reliability.sh`).
 
+mod common;
 mod reliability;
 
 use reliability::{Observed, polhode, record, scratch};

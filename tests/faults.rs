@@ -7,11 +7,12 @@
 
 #![cfg(unix)]
 
+mod common;
 mod reliability;
 
 use reliability::{Observed, polhode, record, scratch};
 use std::os::unix::process::CommandExt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -459,7 +460,7 @@ fn merge_refuses_truncated_and_altered_shards() {
 
 /// Runs `polhode run` on `yaml` (written to a scratch file) with `args`; returns the output and
 /// the directory.
-fn run_yaml(name: &str, yaml: &str, args: &[&str]) -> (Output, PathBuf) {
+fn run_yaml(name: &str, yaml: &str, args: &[&str]) -> (Output, common::Scratch) {
     let dir = scratch(name);
     std::fs::write(dir.join("s.yaml"), yaml).unwrap();
     let out = polhode()

@@ -2,6 +2,8 @@
 //! its protobuf decoder (tests/python/read_mcap.py), in the venv that `scripts/test.sh`
 //! creates. The test fails (it does not skip) when the venv is missing.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -19,11 +21,9 @@ fn python() -> PathBuf {
     p
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-reader-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-reader", name)
 }
 
 fn run_polhode(scenario: &Path, out: &Path, extra: &[&str]) {

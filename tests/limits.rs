@@ -200,12 +200,9 @@ fn polhode() -> std::process::Command {
     std::process::Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-limits-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-limits", name)
 }
 
 /// A campaign of `runs` short rigid-body runs.

@@ -19,6 +19,8 @@
 //! −g₃/I₃), and the transverse block is [[−g₁/I₁, A/I₁], [B/I₂, −g₂/I₂]] with h = 0;
 //! axisymmetric: λ = −g_t/I_t ± i (I_s − I_t) Ω / I_t.
 
+mod common;
+
 use approx::assert_relative_eq;
 use polhode::linearize::{Linearization, Mode, linearize, spin_rate_of};
 use polhode::scenario::{Overrides, Scenario, parse};
@@ -436,8 +438,7 @@ fn cli_prints_the_gyrostat() {
 /// and time constant, no equilibrium warning.
 #[test]
 fn cli_prints_the_spin_decay_without_an_equilibrium_warning() {
-    let dir = std::env::temp_dir().join(format!("polhode-linearize-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::Scratch::new("polhode-linearize", "rayleigh");
     let path = dir.join("rayleigh.yaml");
     std::fs::write(
         &path,
@@ -559,8 +560,7 @@ fn soft_nutation_damper() -> String {
 /// than tenfold in 60 s, while the formula claims a decay.
 #[test]
 fn an_energy_sink_estimate_outside_its_assumptions_is_a_warning_not_a_number() {
-    let dir = std::env::temp_dir().join(format!("polhode-energy-sink-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::Scratch::new("polhode-energy-sink", "soft");
     let soft = dir.join("soft.yaml");
     std::fs::write(&soft, soft_nutation_damper()).unwrap();
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/nutation-damper.yaml");

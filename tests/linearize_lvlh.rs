@@ -634,8 +634,7 @@ fn cli_reports_the_smallsat_modes() {
     assert_eq!(json["closed_form"]["roll_yaw_stable"], true);
     assert_eq!(json["state_names"][1], "pitch");
 
-    let dir = std::env::temp_dir().join(format!("polhode-lvlh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::Scratch::new("polhode-lvlh", "eccentric");
     let path = dir.join("eccentric.yaml");
     std::fs::write(
         &path,

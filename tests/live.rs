@@ -7,12 +7,14 @@
 //! messages of the MCAP written by the same run, the clock (opcode 2) at each message's log
 //! time before it, and sim time going no faster than asked.
 
+mod common;
+
 use foxglove::messages::FrameTransforms;
 use prost::Message as _;
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
 use std::net::TcpStream;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
@@ -32,11 +34,9 @@ impl Drop for Killed {
     }
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-live-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-live", name)
 }
 
 /// Starts `polhode run` with `args`; returns it and its stderr lines as they come.

@@ -2,6 +2,8 @@
 //! short numbers. One scan runs over a battery of bad inputs (the corpus's and the cases
 //! below) and refuses Debug text, runs of spaces and numbers printed as long decimals.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -9,11 +11,9 @@ fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-messages-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-messages", name)
 }
 
 const BASE: &str = "name: b

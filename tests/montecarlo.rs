@@ -2,6 +2,8 @@
 //! sharding, merge refusing bad shard sets, Ctrl-C keeping a valid partial result, bad
 //! campaign definitions, and the Parquet table read by an independent reader.
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -19,11 +21,9 @@ fn polhode() -> Command {
     c
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-mc-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-mc", name)
 }
 
 fn stderr(o: &Output) -> String {

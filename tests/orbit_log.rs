@@ -2,8 +2,10 @@
 //! the `mcap` crate and decoded by hand (docs/logs.md); a scenario without an orbit has
 //! neither.
 
+mod common;
+
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 /// Equatorial radius of the Earth (km), the sphere altitudes are measured above.
@@ -23,11 +25,9 @@ const OMEGA_LVLH: [u64; 3] = [17, 18, 19];
 /// `/telemetry` field numbers of ω_BN (rad/s, body axes).
 const OMEGA: [u64; 3] = [2, 3, 4];
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-orbit-log-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-orbit-log", name)
 }
 
 /// Runs a shipped scenario for `duration` s and returns its log's bytes.

@@ -3,6 +3,8 @@
 //! only when new, empty or polhode's, one writer at a time, and a name from user text stays
 //! inside its directory. Every refusal exits 2 and writes nothing.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -19,12 +21,9 @@ fn polhode() -> Command {
     c
 }
 
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-outputs-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-outputs", name)
 }
 
 fn stderr(o: &Output) -> String {

@@ -1,19 +1,18 @@
 //! Results a user can trust unattended: models that stop outside their validity, events that
 //! answer the question asked (`once`, `for`), and one status vocabulary across outputs.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-trust-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+fn scratch(name: &str) -> common::Scratch {
+    common::Scratch::new("polhode-trust", name)
 }
 
 fn text(bytes: &[u8]) -> String {

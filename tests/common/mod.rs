@@ -84,3 +84,39 @@ pub fn venv_python() -> std::path::PathBuf {
     );
     p
 }
+
+/// A fresh, empty scratch directory for one test (`<temp>/<prefix>-<pid>-<name>`), removed
+/// with what the test wrote there when the test ends, unless it failed: then it is kept, to be
+/// looked at. Dereferences to its path.
+pub struct Scratch(std::path::PathBuf);
+
+impl Scratch {
+    /// Creates it (emptied first, if a run with the same process id left it).
+    pub fn new(prefix: &str, name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("{prefix}-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        Scratch(dir)
+    }
+}
+
+impl std::ops::Deref for Scratch {
+    type Target = std::path::PathBuf;
+    fn deref(&self) -> &std::path::PathBuf {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}

@@ -11,12 +11,9 @@ pub fn polhode() -> Command {
     Command::new(env!("CARGO_BIN_EXE_polhode"))
 }
 
-/// A fresh, empty scratch directory for one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("polhode-hard-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when it passes.
+pub fn scratch(name: &str) -> crate::common::Scratch {
+    crate::common::Scratch::new("polhode-hard", name)
 }
 
 /// What a case did, as observed.
