@@ -30,7 +30,7 @@
 // against the source by eye; the compiler rounds them to the nearest `f64`.
 #![allow(clippy::excessive_precision)]
 
-use super::dopri5::{StageRhs, SystemRhs};
+use super::dopri5::{StageRhs, SystemRhs, non_finite_step_size};
 use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine_on};
 use crate::lanes::Lane;
 
@@ -542,12 +542,6 @@ pub(crate) fn accepted_step_size<L: Lane>(
 #[inline(always)]
 pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
     h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
-}
-
-/// The next step (s) after a step `h` whose stages were not finite.
-#[inline(always)]
-pub(crate) fn non_finite_step_size<L: Lane>(h: L) -> L {
-    L::splat(0.1) * h
 }
 
 /// The seventh-order dense-output coefficients of an accepted step `h` (s) from `y` to

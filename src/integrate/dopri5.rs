@@ -428,7 +428,7 @@ pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
     h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
 }
 
-/// The next step (s) after a step `h` whose stages were not finite.
+/// The next step (s) after a step `h` whose stages were not finite (dopri5's and dop853's).
 #[inline(always)]
 pub(crate) fn non_finite_step_size<L: Lane>(h: L) -> L {
     L::splat(0.1) * h
