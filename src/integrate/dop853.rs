@@ -31,7 +31,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::dopri5::{StageRhs, SystemRhs, non_finite_step_size};
-use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine_on};
+use super::{OdeSystem, Stats, StepControl, StepError, Stepper, Tolerances, combine_on};
 use crate::lanes::Lane;
 
 // Nodes (c₁ = 0, c₁₂ = c₁₃ = 1).
@@ -218,6 +218,13 @@ const FAC_MAX: f64 = 6.0; // and grows by at most 6×
 /// PI-control stabilisation; 0 (Hairer's default for DOP853) makes it the classical
 /// controller `h·(1/err)^{1/8}`. The code keeps the PI form so the term can be tuned.
 const BETA: f64 = 0.0;
+/// The step-size controller with these settings.
+pub(crate) const CONTROL: StepControl = StepControl {
+    safety: SAFETY,
+    fac_min: FAC_MIN,
+    fac_max: FAC_MAX,
+    beta: BETA,
+};
 const EXPO: f64 = 1.0 / 8.0 - 0.2 * BETA;
 const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
 
@@ -514,34 +521,6 @@ pub(crate) fn error_factor<L: Lane>(err: L) -> L {
     } else {
         err.powf(EXPO)
     }
-}
-
-/// After an accepted step `h` (s) with error `err` and its factor `fac11`
-/// ([`error_factor`]): the next step by the PI controller (no longer than `h` where the step
-/// followed rejections) and the new `fac_old`.
-#[inline(always)]
-pub(crate) fn accepted_step_size<L: Lane>(
-    err: L,
-    fac11: L,
-    h: L,
-    fac_old: L,
-    after_rejections: L::Mask,
-) -> (L, L) {
-    let fac = if BETA == 0.0 {
-        fac11
-    } else {
-        fac11 / fac_old.powf(BETA)
-    };
-    let fac = (fac / L::splat(SAFETY)).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-    let h_new = h / fac;
-    let h_new = L::select(after_rejections, h_new.min(h), h_new);
-    (h_new, err.max(L::splat(1e-4)))
-}
-
-/// The next step (s) after a rejected step `h` whose error had factor `fac11`.
-#[inline(always)]
-pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
-    h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
 }
 
 /// The seventh-order dense-output coefficients of an accepted step `h` (s) from `y` to
@@ -902,7 +881,7 @@ impl Stepper for Dop853 {
             if err <= 1.0 {
                 // Accepted: (PI) controller for the next step.
                 let (h_new, fac_old) =
-                    accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
+                    CONTROL.accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
                 self.fac_old = fac_old;
                 if self.dense == DenseOutput::Eager {
                     self.store_dense_output(h);
@@ -925,7 +904,7 @@ impl Stepper for Dop853 {
             if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                 return Err(StepError::StepSizeUnderflow { t: self.t, h });
             }
-            self.h = rejected_step_size(fac11, h);
+            self.h = CONTROL.rejected_step_size(fac11, h);
         }
     }
 
@@ -1663,7 +1642,7 @@ mod tests {
         let t_third = lane(&|i| scalar[i].1);
         let mut third = [zero; 3];
         dense_interior(t_third, zero, h, &cont, &mut third);
-        let (h_next, _) = accepted_step_size(
+        let (h_next, _) = CONTROL.accepted_step_size(
             err,
             error_factor(err),
             h,

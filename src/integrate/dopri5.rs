@@ -4,7 +4,7 @@
 //! J. Comput. Appl. Math. 6 (1980); dense-output coefficients and the PI controller as
 //! described in Hairer, Nørsett & Wanner, *Solving ODEs I* (2nd ed.), §II.4–II.6.
 
-use super::{OdeSystem, Stats, StepError, Stepper, Tolerances, combine};
+use super::{OdeSystem, Stats, StepControl, StepError, Stepper, Tolerances, combine};
 use crate::lanes::Lane;
 use crate::lanes::elementary::positive_powf;
 
@@ -51,6 +51,13 @@ const SAFETY: f64 = 0.9;
 const FAC_MIN: f64 = 0.2; // the step shrinks by at most 5×
 const FAC_MAX: f64 = 10.0; // and grows by at most 10×
 const BETA: f64 = 0.04; // PI-control stabilisation
+/// The step-size controller with these settings.
+pub(crate) const CONTROL: StepControl = StepControl {
+    safety: SAFETY,
+    fac_min: FAC_MIN,
+    fac_max: FAC_MAX,
+    beta: BETA,
+};
 const MAX_REJECTIONS_IN_A_ROW: u32 = 100;
 
 /// Adaptive Dormand–Prince 5(4) ("dopri5", the method behind MATLAB's ode45 and SciPy's RK45).
@@ -397,35 +404,11 @@ pub(crate) fn error_factor<L: Lane>(err: L) -> L {
     positive_powf(err, 0.2 - 0.75 * BETA)
 }
 
-/// After an accepted step `h` (s) with error `err` and its factor `fac11`
-/// ([`error_factor`]): the next step by the PI controller (no longer than `h` where the step
-/// followed rejections) and the new `fac_old`.
-#[inline(always)]
-pub(crate) fn accepted_step_size<L: Lane>(
-    err: L,
-    fac11: L,
-    h: L,
-    fac_old: L,
-    after_rejections: L::Mask,
-) -> (L, L) {
-    let fac = fac11 / positive_powf(fac_old, BETA);
-    let fac = (fac / L::splat(SAFETY)).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-    let h_new = h / fac;
-    let h_new = L::select(after_rejections, h_new.min(h), h_new);
-    (h_new, err.max(L::splat(1e-4)))
-}
-
 /// The proposal kept after an accepted step that proposes `h_new` (s): a step shortened to
 /// land on the end (`last`) does not shrink the standing `proposal`.
 #[inline(always)]
 pub(crate) fn kept_proposal<L: Lane>(last: L::Mask, proposal: L, h_new: L) -> L {
     L::select(last, proposal.max(h_new), h_new)
-}
-
-/// The next step (s) after a rejected step `h` whose error had factor `fac11`.
-#[inline(always)]
-pub(crate) fn rejected_step_size<L: Lane>(fac11: L, h: L) -> L {
-    h / L::splat(1.0 / FAC_MIN).min(fac11 / L::splat(SAFETY))
 }
 
 /// The next step (s) after a step `h` whose stages were not finite (dopri5's and dop853's).
@@ -498,7 +481,7 @@ impl Stepper for Dopri5 {
             if err <= 1.0 {
                 // Accepted: PI controller for the next step.
                 let (h_new, fac_old) =
-                    accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
+                    CONTROL.accepted_step_size(err, fac11, h, self.fac_old, rejected_in_a_row > 0);
                 self.fac_old = fac_old;
                 self.store_dense_output(h);
                 std::mem::swap(&mut self.y, &mut self.y_new);
@@ -516,7 +499,7 @@ impl Stepper for Dopri5 {
             if rejected_in_a_row > MAX_REJECTIONS_IN_A_ROW {
                 return Err(StepError::StepSizeUnderflow { t: self.t, h });
             }
-            self.h = rejected_step_size(fac11, h);
+            self.h = CONTROL.rejected_step_size(fac11, h);
         }
     }
 

@@ -213,6 +213,53 @@ pub struct Tolerances {
     pub atol: f64,
 }
 
+/// The PI step-size controller of Hairer's codes (Hairer, Nørsett & Wanner, "Solving
+/// Ordinary Differential Equations I", §II.4): its safety factor, the bounds on a step's
+/// change and its stabilisation β (0: the classical controller). Each method has its own
+/// settings (`dopri5::CONTROL`, `dop853::CONTROL`); the arithmetic is the same, per lane.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepControl {
+    /// Safety factor on the proposed step.
+    pub safety: f64,
+    /// The step shrinks to no less than `fac_min` times itself after a rejection…
+    pub fac_min: f64,
+    /// …and grows to no more than `fac_max` times itself after an acceptance.
+    pub fac_max: f64,
+    /// PI stabilisation β.
+    pub beta: f64,
+}
+
+impl StepControl {
+    /// After an accepted step `h` (s) with error `err` and its factor `fac11` (the method's
+    /// `error_factor`): the next step (no longer than `h` where the step followed
+    /// rejections) and the new `fac_old`.
+    #[inline(always)]
+    pub(crate) fn accepted_step_size<L: Lane>(
+        &self,
+        err: L,
+        fac11: L,
+        h: L,
+        fac_old: L,
+        after_rejections: L::Mask,
+    ) -> (L, L) {
+        let fac = if self.beta == 0.0 {
+            fac11
+        } else {
+            fac11 / crate::lanes::elementary::positive_powf(fac_old, self.beta)
+        };
+        let fac = (fac / L::splat(self.safety)).clamp(1.0 / self.fac_max, 1.0 / self.fac_min);
+        let h_new = h / fac;
+        let h_new = L::select(after_rejections, h_new.min(h), h_new);
+        (h_new, err.max(L::splat(1e-4)))
+    }
+
+    /// The next step (s) after a rejected step `h` whose error had factor `fac11`.
+    #[inline(always)]
+    pub(crate) fn rejected_step_size<L: Lane>(&self, fac11: L, h: L) -> L {
+        h / L::splat(1.0 / self.fac_min).min(fac11 / L::splat(self.safety))
+    }
+}
+
 /// [`combine`] through its build for AVX2 when `avx2` (the caller asked
 /// [`crate::cpu::avx2_available`] once): the same bits, four lanes per instruction.
 #[inline(always)]

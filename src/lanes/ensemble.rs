@@ -27,8 +27,8 @@
 
 use super::{F64x4, Lane, LaneMask, linalg};
 use crate::integrate::dopri5::{
-    MAX_REJECTIONS, StageRhs, accepted_step_size, dense_coefficients, dense_interior, error_factor,
-    error_norm, initial_step, kept_proposal, non_finite_step_size, rejected_step_size, stages,
+    CONTROL, MAX_REJECTIONS, StageRhs, dense_coefficients, dense_interior, error_factor,
+    error_norm, initial_step, kept_proposal, non_finite_step_size, stages,
 };
 use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
 
@@ -965,10 +965,10 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         let reject = running & !accept;
         let after_rejections = self.rejected_in_a_row.greater_than(zero);
         let (h_accepted, fac_old) =
-            accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
+            CONTROL.accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
         let h_rejected = L::select(
             finite,
-            rejected_step_size(fac11, h),
+            CONTROL.rejected_step_size(fac11, h),
             non_finite_step_size(h),
         );
         self.h = L::select(
