@@ -17,8 +17,8 @@ use polhode::effectors::spring_mass::SpringMass;
 use polhode::integrate::{Dopri5, Stats, Stepper, Tolerances};
 use polhode::lanes::damper::{DIM, DamperRun};
 use polhode::lanes::ensemble::{
-    Engine, GridObservation, LaneObservation, LaneOutcome, LaneSettings, LaneStatus,
-    integrate_runs, integrate_runs_observed_with, integrate_runs_with,
+    Engine, GridObservation, LaneMethodKind, LaneObservation, LaneOutcome, LaneSettings,
+    LaneStatus, integrate_runs, integrate_runs_observed_with, integrate_runs_with,
 };
 use polhode::model::{RigidBody, Spacecraft};
 use polhode::sim::Reference;
@@ -26,6 +26,7 @@ use std::time::Instant;
 
 /// The scenario's tolerances (scenarios/nutation-damper.yaml).
 const SETTINGS: LaneSettings = LaneSettings {
+    method: LaneMethodKind::Dopri5,
     tolerances: Tolerances {
         rtol: 1e-11,
         atol: 1e-13,
@@ -260,9 +261,9 @@ fn observed_steps_carry_the_scalar_observations_and_grid_samples() {
                             s.observation.nutation_angle.to_bits(),
                             "{what}: handed nutation angle"
                         );
-                        let mut cont = [[0.0; 10]; 5];
-                        rest.coefficients(&mut cont);
-                        step.interpolate(&y, &cont, tk, &mut buf);
+                        assert!(rest.prepare_interpolation());
+                        let interpolant = rest.interpolant();
+                        interpolant.value(tk, step.t_prev, step.t, &y, &mut buf);
                         for (j, (a, b)) in s.y.iter().zip(&buf).enumerate() {
                             assert_eq!(a.to_bits(), b.to_bits(), "{what}: sample state {j}");
                         }
@@ -348,6 +349,7 @@ fn lanes_that_end_at_different_times_equal_the_scalar_runs() {
 #[test]
 fn rejected_steps_match_the_scalar_runs() {
     let loose = LaneSettings {
+        method: LaneMethodKind::Dopri5,
         tolerances: Tolerances {
             rtol: 1e-3,
             atol: 1e-6,

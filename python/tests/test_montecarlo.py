@@ -91,8 +91,16 @@ def test_a_damper_campaign_runs_in_lanes_with_the_scalar_rows(polhode_cli, tmp_p
 
 
 def test_a_scene_without_a_lane_form_says_why():
-    campaign = polhode.montecarlo(polhode.load(SINK), runs=2)
+    campaign = polhode.montecarlo(polhode.load(SINK), runs=2, method="radau5")
     assert "no lane form" in campaign.integration, campaign.integration
+    assert "radau5" in campaign.integration, campaign.integration
+
+
+def test_an_energy_sink_campaign_runs_in_lanes_with_the_scalar_rows():
+    lanes = polhode.montecarlo(polhode.load(SINK), runs=12, seed=5, threads=2)
+    assert lanes.integration.startswith("in lockstep lane"), lanes.integration
+    scalar = polhode.montecarlo(polhode.load(SINK), runs=12, seed=5, threads=1, lanes=False)
+    assert lanes.parquet == scalar.parquet
 
 
 def test_to_pandas_is_the_table():

@@ -258,6 +258,17 @@ impl Combine<f64> for ScalarCombine {
     }
 }
 
+/// The lanes' [`Combine`]: [`combine`] itself, compiled with the caller (the lockstep
+/// engines' instruction set).
+pub(crate) struct PlainCombine;
+
+impl<L: Lane> Combine<L> for PlainCombine {
+    #[inline(always)]
+    fn combine<const M: usize>(&self, out: &mut [L], base: &[L], h: L, a: [f64; M], k: [&[L]; M]) {
+        super::combine::<L, M>(out, base, h, a, k)
+    }
+}
+
 /// Starting step (s) by Hairer's `HINIT` (order 8, RMS norms) from `(t, y)` with
 /// `k1 = f(t, y)`, for a span `span` (s) and a cap `h_max` (s); evaluates `rhs` once (into
 /// `k2`, with `stage` as scratch).
@@ -1548,21 +1559,6 @@ mod tests {
     }
 
     /// The lanes' way of forming stage arguments: `combine` itself.
-    struct LaneCombine;
-
-    impl<L: Lane> Combine<L> for LaneCombine {
-        fn combine<const M: usize>(
-            &self,
-            out: &mut [L],
-            base: &[L],
-            h: L,
-            a: [f64; M],
-            k: [&[L]; M],
-        ) {
-            super::super::combine::<L, M>(out, base, h, a, k)
-        }
-    }
-
     #[test]
     fn a_first_step_in_four_lanes_is_each_runs_scalar_step_bit_for_bit() {
         use crate::lanes::{F64x4, LaneMask};
@@ -1614,7 +1610,7 @@ mod tests {
         let [k1, k2, ..] = &mut k;
         let h = initial_step(
             &mut rhs,
-            &LaneCombine,
+            &PlainCombine,
             zero,
             &y,
             k1,
@@ -1624,7 +1620,7 @@ mod tests {
             F64x4::splat(f64::INFINITY),
             F64x4::splat(t_end),
         );
-        stages(&mut rhs, &LaneCombine, zero, h, &y, &mut k, &mut stage);
+        stages(&mut rhs, &PlainCombine, zero, h, &y, &mut k, &mut stage);
         let stage_values = [0, 5, 6, 7, 8, 9, 10, 11].map(|j| &k[j][..]);
         solution_and_errors(
             (h, atol, rtol),
@@ -1636,7 +1632,7 @@ mod tests {
         );
         let err = error_estimate(h, &scaled3, &scaled5);
         body.eval(&y_new, &mut k[12]);
-        dense_stages(&mut rhs, &LaneCombine, zero, h, &y, &mut k, &mut stage);
+        dense_stages(&mut rhs, &PlainCombine, zero, h, &y, &mut k, &mut stage);
         let mut cont = [[zero; 3]; 8];
         dense_coefficients(h, &y, &y_new, &k, &mut cont);
         let t_third = lane(&|i| scalar[i].1);

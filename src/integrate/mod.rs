@@ -6,7 +6,7 @@
 //! (fixed-step, adaptive, implicit, a closed-form propagator) only has to provide these few
 //! operations.
 
-mod dop853;
+pub(crate) mod dop853;
 pub(crate) mod dopri5;
 mod gauss;
 mod grid;

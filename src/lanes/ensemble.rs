@@ -25,11 +25,10 @@
 //! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
 //! here: breakpoints (a scene with one takes no class).
 
+use super::methods::{Dop853, Dopri5, LaneMethod, MethodFamily};
+pub use super::methods::{LaneInterpolant, LaneMethodKind};
 use super::{F64x4, Lane, LaneMask, linalg};
-use crate::integrate::dopri5::{
-    CONTROL, MAX_REJECTIONS, StageRhs, dense_coefficients, dense_interior, error_factor,
-    error_norm, initial_step, kept_proposal, non_finite_step_size, stages,
-};
+use crate::integrate::dopri5::{MAX_REJECTIONS, StageRhs, kept_proposal, non_finite_step_size};
 use crate::integrate::{Stats, StepError, Tolerances, adaptive_step_end};
 
 /// One run of a class the lanes integrate, whose state has `DIM` components (the scalar
@@ -67,10 +66,12 @@ pub trait LaneSystem<L: Lane, const DIM: usize, R> {
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L>;
 }
 
-/// The integration settings every run of a campaign shares (as the scalar `Dopri5::new`
-/// takes them, with the first step chosen automatically).
+/// The integration settings every run of a campaign shares (as the scalar `Dopri5::new` and
+/// `Dop853::new` take them, with the first step chosen automatically).
 #[derive(Debug, Clone, Copy)]
 pub struct LaneSettings {
+    /// The method.
+    pub method: LaneMethodKind,
     /// Tolerances of the error control.
     pub tolerances: Tolerances,
     /// Largest step (s); `f64::INFINITY` for none.
@@ -308,8 +309,11 @@ pub trait StepInLanes<const DIM: usize> {
     /// The step's first grid time strictly inside it, if there is one, with the state there
     /// and its observation (of an observed integration).
     fn sample(&self) -> Option<LaneSample<DIM>>;
-    /// The step's dense-output coefficients (those of the scalar `Dopri5`), into `out`.
-    fn coefficients(&self, out: &mut [[f64; DIM]; 5]);
+    /// Makes the step's dense output available (dop853's dense stages, evaluated and counted
+    /// as the scalar `Dop853::prepare_interpolation` does); false where it is not finite.
+    fn prepare_interpolation(&mut self) -> bool;
+    /// The step's dense output, as the scalar method forms it (prepared first).
+    fn interpolant(&self) -> LaneInterpolant<DIM>;
 }
 
 /// Lane `i` of `value`, read where it lies (a method called outside the engine's compiled
@@ -322,12 +326,14 @@ fn read<L: Lane>(value: &L, i: usize) -> f64 {
 }
 
 /// Lane `lane`'s step in the lanes.
-struct LaneRest<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> {
-    lanes: &'a Lanes<L, R, DIM>,
+struct LaneRest<'a, L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> {
+    lanes: &'a mut Lanes<L, R, M, DIM>,
     lane: usize,
 }
 
-impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> StepInLanes<DIM> for LaneRest<'_, L, R, DIM> {
+impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> StepInLanes<DIM>
+    for LaneRest<'_, L, R, M, DIM>
+{
     fn state(&self, out: &mut [f64; DIM]) {
         L::gather_lane(&self.lanes.y, self.lane, out);
     }
@@ -357,18 +363,22 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> StepInLanes<DIM> for LaneRest<'
             _ => None,
         }
     }
-    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
-        // The scalar `Dopri5`'s arithmetic on this lane's stages (the lanes' arithmetic is
-        // the same, lane by lane).
-        let (lanes, i) = (self.lanes, self.lane);
-        let mut k = [[0.0; DIM]; 7];
-        for (k, stage) in k.iter_mut().zip(lanes.step_stages()) {
-            L::gather_lane(stage, i, k);
-        }
+    fn prepare_interpolation(&mut self) -> bool {
+        let i = self.lane;
+        self.lanes
+            .prepare_dense(L::Mask::splat(false).with_lane(i, true));
+        self.lanes.dense_finite.test(i)
+    }
+    fn interpolant(&self) -> LaneInterpolant<DIM> {
+        // The scalar method's arithmetic on this lane's stages (the lanes' arithmetic is the
+        // same, lane by lane).
+        let (lanes, i) = (&*self.lanes, self.lane);
         let (mut y_start, mut y_new) = ([0.0; DIM], [0.0; DIM]);
         L::gather_lane(&lanes.y_start, i, &mut y_start);
         L::gather_lane(&lanes.y_new, i, &mut y_new);
-        dense_coefficients(read(&lanes.h_step, i), &k, &y_start, &y_new, out);
+        lanes
+            .method
+            .interpolant(i, read(&lanes.h_step, i), &y_start, &y_new)
     }
 }
 
@@ -387,25 +397,16 @@ impl<const DIM: usize> StepInLanes<DIM> for Settled<DIM> {
     fn sample(&self) -> Option<LaneSample<DIM>> {
         None
     }
-    fn coefficients(&self, out: &mut [[f64; DIM]; 5]) {
-        *out = [[0.0; DIM]; 5];
+    fn prepare_interpolation(&mut self) -> bool {
+        true
+    }
+    fn interpolant(&self) -> LaneInterpolant<DIM> {
+        // Read at the step's ends only (it has no interior).
+        LaneInterpolant::Dopri5([[0.0; DIM]; 5])
     }
 }
 
 impl LaneStep {
-    /// The state at `t` (s) in the step, from its end state `y` ([`StepInLanes::state`]) and
-    /// its dense-output coefficients `cont` ([`StepInLanes::coefficients`]), as the scalar
-    /// `Dopri5` interpolates.
-    pub fn interpolate<const DIM: usize>(
-        &self,
-        y: &[f64; DIM],
-        cont: &[[f64; DIM]; 5],
-        t: f64,
-        out: &mut [f64],
-    ) {
-        crate::integrate::dopri5::dense_value(t, self.t_prev, self.t, y, cont, out);
-    }
-
     /// The step view of a run standing at `t` (s) in state `y` after the work `stats`, with
     /// its state: no step to interpolate in.
     pub fn settled<const DIM: usize>(t: f64, y: [f64; DIM], stats: Stats) -> (Self, Settled<DIM>) {
@@ -442,7 +443,7 @@ pub struct LaneOutcome<const DIM: usize> {
 /// rest)`, the run's index, its step and the rest of the step in the lanes; false ends the
 /// run there.
 pub type Observer<'o, const DIM: usize> =
-    &'o mut dyn FnMut(usize, &LaneStep, &dyn StepInLanes<DIM>) -> bool;
+    &'o mut dyn FnMut(usize, &LaneStep, &mut dyn StepInLanes<DIM>) -> bool;
 
 /// Which compiled engine runs the lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -535,19 +536,31 @@ fn run_engine<R: LaneRun<DIM>, const DIM: usize>(
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
+    match settings.method {
+        LaneMethodKind::Dopri5 => run_method::<R, Dopri5, DIM>(engine, runs, settings, observe),
+        LaneMethodKind::Dop853 => run_method::<R, Dop853, DIM>(engine, runs, settings, observe),
+    }
+}
+
+fn run_method<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
+    engine: Engine,
+    runs: &[R],
+    settings: &LaneSettings,
+    observe: Observing<'_, DIM>,
+) -> Vec<LaneOutcome<DIM>> {
     match resolved(engine) {
-        Engine::Portable4 => lockstep::<F64x4, R, DIM>(runs, settings, observe),
+        Engine::Portable4 => lockstep::<F64x4, R, F, DIM>(runs, settings, observe),
         #[cfg(target_arch = "x86_64")]
         Engine::Avx2 => {
             // SAFETY: `resolved` chose AVX2 only where the processor has it.
-            unsafe { lockstep_avx2(runs, settings, observe) }
+            unsafe { lockstep_avx2::<R, F, DIM>(runs, settings, observe) }
         }
         #[cfg(target_arch = "x86_64")]
         Engine::Avx512 => {
             // SAFETY: `resolved` chose AVX-512F only where the processor has it.
-            unsafe { lockstep_avx512(runs, settings, observe) }
+            unsafe { lockstep_avx512::<R, F, DIM>(runs, settings, observe) }
         }
-        _ => lockstep::<f64, R, DIM>(runs, settings, observe),
+        _ => lockstep::<f64, R, F, DIM>(runs, settings, observe),
     }
 }
 
@@ -556,12 +569,12 @@ fn run_engine<R: LaneRun<DIM>, const DIM: usize>(
 /// path's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn lockstep_avx2<R: LaneRun<DIM>, const DIM: usize>(
+unsafe fn lockstep_avx2<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     runs: &[R],
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
-    lockstep::<F64x4, R, DIM>(runs, settings, observe)
+    lockstep::<F64x4, R, F, DIM>(runs, settings, observe)
 }
 
 /// [`lockstep`] at eight lanes, compiled for AVX-512F so that the lane type's intrinsics
@@ -569,12 +582,12 @@ unsafe fn lockstep_avx2<R: LaneRun<DIM>, const DIM: usize>(
 /// fused intrinsic is called, and Rust contracts nothing): the bits are the scalar path's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn lockstep_avx512<R: LaneRun<DIM>, const DIM: usize>(
+unsafe fn lockstep_avx512<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     runs: &[R],
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
-    lockstep::<super::f64x8::F64x8, R, DIM>(runs, settings, observe)
+    lockstep::<super::f64x8::F64x8, R, F, DIM>(runs, settings, observe)
 }
 
 /// The system as the stages' right-hand side, noting the lanes whose closed form was solved
@@ -601,8 +614,10 @@ struct SampleLanes<L: Lane, const DIM: usize> {
 }
 
 /// The lanes' integration state: each field holds one value per lane.
-struct Lanes<L: Lane, R: LaneRun<DIM>, const DIM: usize> {
+struct Lanes<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> {
     system: R::System<L>,
+    /// The method's stages.
+    method: M,
     /// The shared settings, splat.
     atol: L,
     rtol: L,
@@ -617,13 +632,15 @@ struct Lanes<L: Lane, R: LaneRun<DIM>, const DIM: usize> {
     y: [L; DIM],
     y_new: [L; DIM],
     stage: [L; DIM],
-    k: [[L; DIM]; 7],
-    /// The state and the first stage at the start of the last attempted step and its size
-    /// (s), when observed: with the other stages and `y_new`, what its dense output is
-    /// formed of (only where it is read: [`Lanes::sample_inside`], [`LaneRest`]).
+    /// The state at the start of the last attempted step and its size (s), when observed:
+    /// with the method's stages and `y_new`, what its dense output is formed of (only where
+    /// it is read: [`Lanes::sample_inside`], [`LaneRest`]).
     y_start: [L; DIM],
-    k_start: [L; DIM],
     h_step: L,
+    /// The lanes whose last step's dense stages are evaluated (all, for a method whose dense
+    /// output needs none), and those where they came out finite.
+    dense_ready: L::Mask,
+    dense_finite: L::Mask,
     /// The observation at the end of the last accepted step, when observed, and the drift
     /// there from each run's start.
     end: Option<LaneObservation<L>>,
@@ -651,7 +668,7 @@ struct Lanes<L: Lane, R: LaneRun<DIM>, const DIM: usize> {
     ended: Vec<(usize, LaneStatus)>,
 }
 
-impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
+impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L, R, M, DIM> {
     /// Every lane empty, holding `run`'s values (finite, so that idle lanes compute harmless
     /// numbers).
     #[inline(always)]
@@ -659,6 +676,7 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         let z = L::splat(0.0);
         let mut lanes = Lanes {
             system: R::System::<L>::idle(),
+            method: M::zeroed(),
             atol: L::splat(settings.tolerances.atol),
             rtol: L::splat(settings.tolerances.rtol),
             h_max: L::splat(settings.h_max),
@@ -670,10 +688,10 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
             y: [z; DIM],
             y_new: [z; DIM],
             stage: [z; DIM],
-            k: [[z; DIM]; 7],
             y_start: [z; DIM],
-            k_start: [z; DIM],
             h_step: z,
+            dense_ready: L::Mask::splat(true),
+            dense_finite: L::Mask::splat(true),
             end: None,
             drift: None,
             reference: None,
@@ -741,14 +759,6 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         }
     }
 
-    /// The last attempted step's stages as its dense output reads them: its first stage as
-    /// it was at the step's start (`k[0]` holds the next step's once the step is accepted).
-    #[inline(always)]
-    fn step_stages(&self) -> [&[L; DIM]; 7] {
-        let [_, k2, k3, k4, k5, k6, k7] = &self.k;
-        [&self.k_start, k2, k3, k4, k5, k6, k7]
-    }
-
     /// Lane `i`'s last accepted step (of an observed integration), into `step`: the numbers
     /// read at every step, the rest left in the lanes ([`LaneRest`]).
     #[inline(always)]
@@ -784,7 +794,8 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
     }
 
     /// Ends lane `i`'s run as [`LaneStatus::Ended`], whether it was still running or had just
-    /// ended (reaching its end time) in the last attempt.
+    /// ended (reaching its end time) in the last attempt; a run the lanes declined stays
+    /// declined.
     #[cold]
     #[inline(never)]
     fn end_observed(&mut self, i: usize) {
@@ -792,7 +803,11 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
             self.end(L::Mask::splat(false).with_lane(i, true), |_, _| {
                 LaneStatus::Ended
             });
-        } else if let Some(e) = self.ended.iter_mut().find(|e| e.0 == i) {
+        } else if let Some(e) = self
+            .ended
+            .iter_mut()
+            .find(|e| e.0 == i && !matches!(e.1, LaneStatus::Declined { .. }))
+        {
             e.1 = LaneStatus::Ended;
         }
     }
@@ -837,8 +852,9 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         let solved = system.rhs(&self.y, &mut first);
         self.rhs_evaluations += L::select(starting, one, zero);
         let mut finite = L::Mask::splat(true);
+        let k1 = self.method.first_stage();
         for (j, &f) in first.iter().enumerate() {
-            self.k[0][j] = L::select(starting, f, self.k[0][j]);
+            k1[j] = L::select(starting, f, k1[j]);
             finite = finite & f.is_finite();
         }
         let declined = starting & !solved;
@@ -856,16 +872,12 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
             system: &self.system,
             solved: L::Mask::splat(true),
         };
-        let [k1, k2, ..] = &mut self.k;
-        let h = initial_step(
+        let h = self.method.initial_step(
             &mut rhs,
             self.t,
             &self.y,
-            k1,
-            k2,
             &mut self.stage,
-            self.atol,
-            self.rtol,
+            (self.atol, self.rtol),
             self.h_max,
             self.t_end - self.t,
         );
@@ -891,12 +903,18 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         let t_k = self.next_sample / self.sample_rate;
         let due = gridded & t_k.less_than(self.t);
         self.sample = if due.any() {
+            // The scalar monitor prepares the dense output of a step with a grid time inside.
+            self.prepare_dense(due);
             let mut y = [zero; DIM];
-            // The step's dense output (what the observation does not read of it is dropped).
-            let mut cont = [[zero; DIM]; 5];
-            let k = self.step_stages();
-            dense_coefficients(self.h_step, &k, &self.y_start, &self.y_new, &mut cont);
-            dense_interior(t_k, self.t_prev, self.t, &cont, &mut y);
+            self.method.dense_interior(
+                self.h_step,
+                t_k,
+                self.t_prev,
+                self.t,
+                &self.y_start,
+                &self.y_new,
+                &mut y,
+            );
             let observation = self.system.observe(&y);
             Some(SampleLanes {
                 due,
@@ -916,8 +934,43 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         }
     }
 
+    /// The dense-output stages of the last attempted step for the lanes of `needed` whose
+    /// stages are not yet evaluated, counted for them (evaluated for every lane at once: each
+    /// lane's values are its own whichever asked); notes where they came out finite.
+    #[inline(always)]
+    fn prepare_dense(&mut self, needed: L::Mask) {
+        if M::DENSE_EVALUATIONS == 0.0 {
+            return;
+        }
+        let needed = needed & !self.dense_ready;
+        if !needed.any() {
+            return;
+        }
+        let mut rhs = Solving::<L, R, DIM> {
+            system: &self.system,
+            solved: L::Mask::splat(true),
+        };
+        let finite = self.method.dense_stages(
+            &mut rhs,
+            self.t_prev,
+            self.h_step,
+            &self.y_start,
+            &mut self.stage,
+        );
+        // A lane whose closed form declined a dense stage is run again on the scalar path.
+        let declined = needed & !rhs.solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined {
+                t: s.t_prev.lane(i),
+            });
+        }
+        self.rhs_evaluations += L::select(needed, L::splat(M::DENSE_EVALUATIONS), L::splat(0.0));
+        self.dense_finite = (self.dense_finite & !needed) | (finite & needed);
+        self.dense_ready = self.dense_ready | needed;
+    }
+
     /// One attempted step in every running lane, accepted or rejected lane by lane, as the
-    /// scalar `Dopri5::step` takes it; returns the lanes that accepted. With `observed`, the
+    /// scalar `Dopri5::step` (or `Dop853::step`) takes it; returns the lanes that accepted. With `observed`, the
     /// accepted steps' dense output is kept.
     #[inline(always)]
     fn attempt(&mut self, observed: bool) -> L::Mask {
@@ -942,33 +995,50 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
             system: &self.system,
             solved: L::Mask::splat(true),
         };
-        stages(
+        let err = self.method.attempt(
             &mut rhs,
             self.t,
             h,
             &self.y,
-            &mut self.k,
-            &mut self.stage,
             &mut self.y_new,
+            &mut self.stage,
+            (self.atol, self.rtol),
         );
         let solved = rhs.solved;
-        self.rhs_evaluations += L::select(self.running, L::splat(6.0), zero);
+        self.rhs_evaluations += L::select(self.running, L::splat(M::ATTEMPT_EVALUATIONS), zero);
         let declined = self.running & !solved;
         if declined.any() {
             self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
         }
         let running = self.running;
-        let err = error_norm(h, &self.k, &self.y, &self.y_new, self.atol, self.rtol);
-        let finite = err.is_finite();
-        let fac11 = error_factor(err);
+        let err_finite = err.is_finite();
+        // dop853's stage 13 (f at the new point), for the steps that passed the error test.
+        let passed = running & err_finite & err.at_most(one);
+        let mut end_finite = L::Mask::splat(true);
+        if M::END_STAGE && passed.any() {
+            let mut rhs = Solving::<L, R, DIM> {
+                system: &self.system,
+                solved: L::Mask::splat(true),
+            };
+            let finite = self.method.end_stage(&mut rhs, end.t_new, &self.y_new);
+            end_finite = !passed | finite;
+            self.rhs_evaluations += L::select(passed, one, zero);
+            let declined = passed & !rhs.solved;
+            if declined.any() {
+                self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+            }
+        }
+        let running = self.running;
+        let finite = err_finite & end_finite;
+        let fac11 = M::error_factor(err);
         let accept = running & finite & err.at_most(one);
         let reject = running & !accept;
         let after_rejections = self.rejected_in_a_row.greater_than(zero);
         let (h_accepted, fac_old) =
-            CONTROL.accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
+            M::CONTROL.accepted_step_size(err, fac11, h, self.fac_old, after_rejections);
         let h_rejected = L::select(
             finite,
-            CONTROL.rejected_step_size(fac11, h),
+            M::CONTROL.rejected_step_size(fac11, h),
             non_finite_step_size(h),
         );
         self.h = L::select(
@@ -979,17 +1049,16 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
         self.fac_old = L::select(accept, fac_old, self.fac_old);
         if observed {
             // What the step's dense output is formed of where it is read (for every lane;
-            // the others' are not read).
+            // the others' are not read). Its dense stages are not evaluated yet.
             self.y_start = self.y;
-            self.k_start = self.k[0];
             self.h_step = h;
             self.t_prev = L::select(accept, self.t, self.t_prev);
+            if M::DENSE_EVALUATIONS != 0.0 {
+                self.dense_ready = L::Mask::splat(false);
+            }
         }
-        for j in 0..DIM {
-            self.y[j] = L::select(accept, self.y_new[j], self.y[j]);
-            // First same as last: the last stage is f at the new point.
-            self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
-        }
+        self.method
+            .accept(accept, observed, &mut self.y, &self.y_new);
         self.t = L::select(accept, end.t_new, self.t);
         if observed && accept.any() {
             let end = self.system.observe(&self.y);
@@ -1029,7 +1098,7 @@ impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Lanes<L, R, DIM> {
 
 /// The lockstep integration of `runs` at lane type `L`; see the module documentation.
 #[inline(always)]
-fn lockstep<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
+fn lockstep<L: Lane, R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     runs: &[R],
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
@@ -1038,7 +1107,7 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
     let Some(first) = runs.first() else {
         return Vec::new();
     };
-    let mut lanes = Lanes::<L, R, DIM>::new(first, settings);
+    let mut lanes = Lanes::<L, R, F::In<L, DIM>, DIM>::new(first, settings);
     let mut observe = observe.map(|(grid, observer)| {
         lanes.grid = grid;
         observer
@@ -1089,11 +1158,11 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
                         && accepted.test(i)
                     {
                         lanes.step_of(i, &mut step);
-                        let rest = LaneRest {
-                            lanes: &lanes,
+                        let mut rest = LaneRest {
+                            lanes: &mut lanes,
                             lane: i,
                         };
-                        if !observe(index, &step, &rest) {
+                        if !observe(index, &step, &mut rest) {
                             lanes.end_observed(i);
                         }
                     }

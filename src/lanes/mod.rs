@@ -26,11 +26,13 @@
 
 pub mod damper;
 pub mod elementary;
+pub mod energy_sink;
 pub mod ensemble;
 pub mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;
 pub mod linalg;
+pub(crate) mod methods;
 #[cfg(test)]
 mod operations_check;
 

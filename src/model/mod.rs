@@ -655,6 +655,12 @@ impl Spacecraft {
         }
     }
 
+    /// Euler's coefficients `[(I₂−I₃)/I₁, (I₃−I₁)/I₂, (I₁−I₂)/I₃]` when the body axes are
+    /// principal (the right-hand side then takes Euler's equations in their three-term form).
+    pub fn euler_coefficients(&self) -> Option<[f64; 3]> {
+        self.euler_coefficients
+    }
+
     /// Appends an effector; its states follow those already present. Effectors that move mass
     /// need the hub mass set first.
     pub fn add_effector(&mut self, effector: Box<dyn Effector>) -> Result<(), AddEffectorError> {
@@ -773,6 +779,19 @@ impl Spacecraft {
     /// gradient and no prescribed motion.
     pub fn takes_lone_closed_form(&self) -> bool {
         self.motion.is_none() && self.lone_only
+    }
+
+    /// Whether the right-hand side is Euler's equations in their three-term form plus the
+    /// effectors' torques, each computed once (`torque_rhs`): principal body axes, every
+    /// effector torque-only (at most a few), no prescribed motion, nothing expelled.
+    pub fn takes_torque_closed_form(&self) -> bool {
+        self.motion.is_none()
+            && !self.lone_only
+            && !self.effectors.is_empty()
+            && self.torque_only
+            && self.effectors.len() <= MAX_FAST_TORQUES
+            && !self.expels_mass
+            && self.euler_coefficients.is_some()
     }
 
     /// The prescribed hub motion, if any.

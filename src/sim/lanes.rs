@@ -3,21 +3,25 @@
 //! the same dense output, so a run's outcome is the scalar path's (docs/montecarlo.md, "Lanes
 //! in a campaign").
 //!
-//! Today's lane form is the nutation-damper class ([`crate::lanes::damper`]): a rigid hub
-//! with one spring–mass damper, integrated by dopri5. [`lane_form`] says why another scene
-//! has none; such a run, or one the lanes decline part-way, takes the scalar path.
+//! Two classes have a lane form ([`LaneForm`]), each integrated by dopri5 or dop853: the
+//! nutation-damper class ([`crate::lanes::damper`], a rigid hub with one spring–mass damper)
+//! and the energy-sink class ([`crate::lanes::energy_sink`], a rigid hub with principal axes
+//! and one energy sink). [`lane_form`] says why another scene has none; such a run, or one
+//! the lanes decline part-way, takes the scalar path.
 
 use super::monitor::{Monitor, StepView};
 use super::{
     Drift, Method, Outcome, Quantity, Simulation, Sink, Status, diagnose, interior_checks,
 };
+use crate::effectors::energy_sink::EnergySink;
 use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
-use crate::lanes::damper::{DIM, DamperRun};
+use crate::lanes::damper::{self, DamperRun};
+use crate::lanes::energy_sink::{self, SinkRun};
 use crate::lanes::ensemble::{
-    Engine, GridObservation, LaneObservation, LaneSettings, LaneStatus, LaneStep, StepInLanes,
-    integrate_runs_observed_with,
+    Engine, GridObservation, LaneInterpolant, LaneMethodKind, LaneObservation, LaneRun,
+    LaneSettings, LaneStatus, LaneStep, StepInLanes, integrate_runs_observed_with,
 };
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
@@ -27,20 +31,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A lane's step as the monitor reads it: the state at its end and its dense output are
 /// read out of the lanes the first time the monitor asks for them.
-struct LaneView<'s> {
+struct LaneView<'s, const DIM: usize> {
     step: &'s LaneStep,
-    rest: &'s dyn StepInLanes<DIM>,
+    rest: &'s mut dyn StepInLanes<DIM>,
     y: OnceCell<[f64; DIM]>,
-    cont: OnceCell<[[f64; DIM]; 5]>,
+    interpolant: OnceCell<LaneInterpolant<DIM>>,
 }
 
-impl<'s> LaneView<'s> {
-    fn new(step: &'s LaneStep, rest: &'s dyn StepInLanes<DIM>) -> Self {
+impl<'s, const DIM: usize> LaneView<'s, DIM> {
+    fn new(step: &'s LaneStep, rest: &'s mut dyn StepInLanes<DIM>) -> Self {
         LaneView {
             step,
             rest,
             y: OnceCell::new(),
-            cont: OnceCell::new(),
+            interpolant: OnceCell::new(),
         }
     }
 
@@ -53,7 +57,7 @@ impl<'s> LaneView<'s> {
     }
 }
 
-impl StepView for LaneView<'_> {
+impl<const DIM: usize> StepView for LaneView<'_, DIM> {
     fn t(&self) -> f64 {
         self.step.t
     }
@@ -67,15 +71,14 @@ impl StepView for LaneView<'_> {
         self.step.finite
     }
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let cont = self.cont.get_or_init(|| {
-            let mut cont = [[0.0; DIM]; 5];
-            self.rest.coefficients(&mut cont);
-            cont
-        });
-        self.step.interpolate(self.state(), cont, t, out);
+        let interpolant = self.interpolant.get_or_init(|| self.rest.interpolant());
+        interpolant.value(t, self.step.t_prev, self.step.t, self.state(), out);
     }
     fn prepare_interpolation(&mut self, _: &Spacecraft) -> bool {
-        true
+        let finite = self.rest.prepare_interpolation();
+        // An interpolant formed before the dense stages were is formed again.
+        self.interpolant.take();
+        finite
     }
     fn stats(&self) -> Stats {
         self.step.stats
@@ -164,41 +167,85 @@ fn observation(
     )
 }
 
-/// `sim` as a run of the lanes' nutation-damper class and the integration settings it needs,
-/// or why it is not one (a sentence fragment: "its method is radau5, …").
-pub fn lane_form(sim: &Simulation) -> Result<(DamperRun, LaneSettings), String> {
+/// A run of a class the lanes integrate.
+#[derive(Debug, Clone)]
+pub enum LaneForm {
+    /// A rigid hub with one spring–mass damper ([`crate::lanes::damper`]).
+    Damper(DamperRun),
+    /// A rigid hub with principal axes and one energy sink ([`crate::lanes::energy_sink`]).
+    EnergySink(SinkRun),
+}
+
+/// `sim` as a run of a class of the lanes and the integration settings it needs, or why it is
+/// not one (a sentence fragment: "its method is radau5, …").
+pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
     let sc = &sim.spacecraft;
-    let Method::Dopri5(a) = sim.method else {
-        return Err(format!(
-            "its method is {}, and the lanes integrate with dopri5 only",
-            sim.method.name()
-        ));
+    let (method, a) = match sim.method {
+        Method::Dopri5(a) => (LaneMethodKind::Dopri5, a),
+        Method::Dop853(a) => (LaneMethodKind::Dop853, a),
+        _ => {
+            return Err(format!(
+                "its method is {}, and the lanes integrate with dopri5 and dop853 only",
+                sim.method.name()
+            ));
+        }
     };
     if let Some(refusal) = sim.method.refusal(sc, sim.duration) {
-        return Err(format!("dopri5 refuses it ({refusal})"));
+        return Err(format!("{} refuses it ({refusal})", sim.method.name()));
     }
-    let damper = match sc.effectors() {
-        [one] => {
-            let any: &dyn Any = one.as_ref();
-            any.downcast_ref::<ParticleEffector<SpringMass>>()
-                .map(ParticleEffector::model)
-                .ok_or_else(|| {
-                    format!(
-                        "its effector `{}` ({}) has no lane form (the lanes have the \
-                         spring_mass_damper alone)",
-                        one.name(),
-                        one.kind()
-                    )
-                })?
-        }
+    let one = match sc.effectors() {
+        [one] => one,
         list => {
             return Err(format!(
-                "it has {} effectors, and the lanes have a hub with one spring_mass_damper only",
+                "it has {} effectors, and the lanes have a hub with one spring_mass_damper or \
+                 one energy_sink only",
                 list.len()
             ));
         }
     };
-    if !sc.takes_lone_closed_form() || sc.next_breakpoint(0.0).is_some() {
+    if sc.next_breakpoint(0.0).is_some() {
+        return Err("it has breakpoints, at which the lanes do not stop".into());
+    }
+    let any: &dyn Any = one.as_ref();
+    let form = if let Some(d) = any.downcast_ref::<ParticleEffector<SpringMass>>() {
+        LaneForm::Damper(damper_run(sim, d.model())?)
+    } else if let Some(sink) = any.downcast_ref::<EnergySink>() {
+        LaneForm::EnergySink(sink_run(sim, sink)?)
+    } else {
+        return Err(format!(
+            "its effector `{}` ({}) has no lane form (the lanes have the spring_mass_damper \
+             and the energy_sink)",
+            one.name(),
+            one.kind()
+        ));
+    };
+    let settings = LaneSettings {
+        method,
+        tolerances: Tolerances {
+            rtol: a.rtol,
+            atol: a.atol,
+        },
+        h_max: a.max_step,
+    };
+    Ok((form, settings))
+}
+
+/// Whether `run` starts where the scalar path starts `sim`, bit for bit (the lanes' layout is
+/// the scalar state's).
+fn same_start<const DIM: usize>(sim: &Simulation, run: &impl LaneRun<DIM>) -> bool {
+    let y0 = sim.spacecraft.initial_state(&sim.omega0, &sim.attitude0);
+    y0.len() == DIM
+        && run
+            .initial_state()
+            .iter()
+            .zip(&y0)
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+}
+
+/// `sim` as a run of the nutation-damper class.
+fn damper_run(sim: &Simulation, damper: &SpringMass) -> Result<DamperRun, String> {
+    let sc = &sim.spacecraft;
+    if !sc.takes_lone_closed_form() {
         return Err("its right-hand side is not the damper's closed form alone".into());
     }
     let hub_mass = sc
@@ -217,23 +264,41 @@ pub fn lane_form(sim: &Simulation) -> Result<(DamperRun, LaneSettings), String> 
         t_end: sim.duration,
         sample_rate: sim.output_rate,
     };
-    let same_start = y0.len() == DIM
-        && run
-            .initial_state()
-            .iter()
-            .zip(&y0)
-            .all(|(a, b)| a.to_bits() == b.to_bits());
-    if !same_start {
+    if !same_start(sim, &run) {
         return Err("its state is not laid out as the lanes' (ω, q, ρ, ρ̇, E)".into());
     }
-    let settings = LaneSettings {
-        tolerances: Tolerances {
-            rtol: a.rtol,
-            atol: a.atol,
-        },
-        h_max: a.max_step,
+    Ok(run)
+}
+
+/// `sim` as a run of the energy-sink class.
+fn sink_run(sim: &Simulation, sink: &EnergySink) -> Result<SinkRun, String> {
+    let sc = &sim.spacecraft;
+    let Some(euler_coefficients) = sc.euler_coefficients() else {
+        return Err(
+            "its body axes are not principal (the lanes take Euler's equations in \
+                    their three-term form)"
+                .into(),
+        );
     };
-    Ok((run, settings))
+    if !sc.takes_torque_closed_form() {
+        return Err("its right-hand side is not Euler's equations with the sink's torque".into());
+    }
+    let inverse = &sc.hub.inertia_inv;
+    let run = SinkRun {
+        hub_inertia: sc.hub.inertia,
+        inverse_inertia: [inverse[(0, 0)], inverse[(1, 1)], inverse[(2, 2)]],
+        euler_coefficients,
+        sink: sink.clone(),
+        omega0: sim.omega0,
+        attitude0: sim.attitude0,
+        spin_axis: sc.spin_axis,
+        t_end: sim.duration,
+        sample_rate: sim.output_rate,
+    };
+    if !same_start(sim, &run) {
+        return Err("its state is not laid out as the lanes' (ω, q, E)".into());
+    }
+    Ok(run)
 }
 
 /// One run in the lanes: its monitor, its sink, and the status its monitor ended it with.
@@ -246,25 +311,65 @@ struct Watched<'a, S> {
 
 /// Runs `sims` (the runs of one campaign) in lockstep lanes with `engine`, each feeding a sink
 /// of its own. Returns, in the order of `sims`, each run's outcome and sink, or `None` for a
-/// run that must take the scalar path: it has no lane form ([`lane_form`]), its settings
-/// differ from the first lane run's, or the lanes declined it part-way (its sink is then
-/// dropped, so a scalar run starts afresh). `interrupt` ends the runs after their current step
-/// with [`Status::Interrupted`].
+/// run that must take the scalar path: it has no lane form ([`lane_form`]), its class or
+/// settings differ from the first lane run's, or the lanes declined it part-way (its sink is
+/// then dropped, so a scalar run starts afresh). `interrupt` ends the runs after their current
+/// step with [`Status::Interrupted`].
 pub fn run_in_lanes<S: Sink + Default>(
     engine: Engine,
     sims: &[&Simulation],
+    interrupt: &AtomicBool,
+) -> std::io::Result<Vec<Option<(Outcome, S)>>> {
+    let forms: Vec<_> = sims.iter().map(|sim| lane_form(sim).ok()).collect();
+    match forms.iter().flatten().next() {
+        Some((LaneForm::Damper(_), _)) => run_class::<S, DamperRun, { damper::DIM }>(
+            engine,
+            sims,
+            forms,
+            |f| match f {
+                LaneForm::Damper(run) => Some(run),
+                _ => None,
+            },
+            interrupt,
+        ),
+        Some((LaneForm::EnergySink(_), _)) => run_class::<S, SinkRun, { energy_sink::DIM }>(
+            engine,
+            sims,
+            forms,
+            |f| match f {
+                LaneForm::EnergySink(run) => Some(run),
+                _ => None,
+            },
+            interrupt,
+        ),
+        None => Ok((0..sims.len()).map(|_| None).collect()),
+    }
+}
+
+/// [`run_in_lanes`] for the runs of the first lane run's class (`of_class` picks them out of
+/// their lane forms `forms`).
+fn run_class<S: Sink + Default, R: LaneRun<DIM>, const DIM: usize>(
+    engine: Engine,
+    sims: &[&Simulation],
+    forms: Vec<Option<(LaneForm, LaneSettings)>>,
+    of_class: impl Fn(LaneForm) -> Option<R>,
     interrupt: &AtomicBool,
 ) -> std::io::Result<Vec<Option<(Outcome, S)>>> {
     let mut results: Vec<Option<(Outcome, S)>> = (0..sims.len()).map(|_| None).collect();
     let mut shared: Option<LaneSettings> = None;
     let mut runs = Vec::new();
     let mut watched: Vec<Watched<S>> = Vec::new();
-    for (index, sim) in sims.iter().enumerate() {
-        let Ok((run, settings)) = lane_form(sim) else {
+    for (index, (sim, form)) in sims.iter().zip(forms).enumerate() {
+        let Some((form, settings)) = form else {
+            continue;
+        };
+        let Some(run) = of_class(form) else {
             continue;
         };
         let same = |s: &LaneSettings| {
-            s.tolerances == settings.tolerances && s.h_max.to_bits() == settings.h_max.to_bits()
+            s.method == settings.method
+                && s.tolerances == settings.tolerances
+                && s.h_max.to_bits() == settings.h_max.to_bits()
         };
         if !same(shared.get_or_insert(settings)) {
             continue;
@@ -275,8 +380,8 @@ pub fn run_in_lanes<S: Sink + Default>(
         let steps_ahead = sim.duration > 0.0;
         if status.is_some() || !steps_ahead {
             // Ended at t = 0, as the scalar loop does without a step.
-            let (start, state) = LaneStep::settled(0.0, y0, Stats::default());
-            let outcome = monitor.finish(&LaneView::new(&start, &state), status, &mut sink)?;
+            let (start, mut state) = LaneStep::settled(0.0, y0, Stats::default());
+            let outcome = monitor.finish(&LaneView::new(&start, &mut state), status, &mut sink)?;
             results[index] = Some((outcome, sink));
             continue;
         }
@@ -333,10 +438,10 @@ pub fn run_in_lanes<S: Sink + Default>(
             }),
         };
         let mut sink = w.sink;
-        let (end, state) = LaneStep::at_end(&outcome);
+        let (end, mut state) = LaneStep::at_end(&outcome);
         let result = w
             .monitor
-            .finish(&LaneView::new(&end, &state), status, &mut sink)?;
+            .finish(&LaneView::new(&end, &mut state), status, &mut sink)?;
         results[w.index] = Some((result, sink));
     }
     Ok(results)

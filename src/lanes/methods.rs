@@ -1,0 +1,485 @@
+//! The explicit Runge–Kutta methods the lockstep ensemble ([`super::ensemble`]) steps with,
+//! in lanes: dopri5 ([`Dopri5Lanes`]) and dop853 ([`Dop853Lanes`]). Each holds its stages in
+//! lanes and calls the arithmetic the scalar method calls at `f64` (`integrate::dopri5`,
+//! `integrate::dop853`), so that a lane's steps are the scalar method's, bit for bit; the
+//! engine takes the decisions (accept, reject, the step size) the same way for both.
+//!
+//! dop853 evaluates stage 13 (f at the new point, the next step's first) only for a step that
+//! passed its error test, and its three dense-output stages only for a step whose interior is
+//! read (the scalar `Dop853::with_lazy_dense_output`): the lanes evaluate them for every lane
+//! at once and count them for the lanes that needed them, as the scalar method would have.
+
+use super::{Lane, LaneMask};
+use crate::integrate::StepControl;
+use crate::integrate::dop853::{self, PlainCombine};
+use crate::integrate::dopri5::{self, StageRhs};
+
+/// The method a campaign's runs are integrated with in the lanes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaneMethodKind {
+    /// Dormand–Prince 5(4), as the scalar `Dopri5`.
+    Dopri5,
+    /// Dormand–Prince 8(5,3), as the scalar `Dop853` with lazy dense output.
+    Dop853,
+}
+
+/// A lane's dense output over its last accepted step, formed as the scalar method forms it.
+#[derive(Debug, Clone)]
+pub enum LaneInterpolant<const DIM: usize> {
+    /// dopri5's five coefficient vectors (`dopri5::dense_coefficients`).
+    Dopri5([[f64; DIM]; 5]),
+    /// dop853's eight (`dop853::dense_coefficients`).
+    Dop853([[f64; DIM]; 8]),
+}
+
+impl<const DIM: usize> LaneInterpolant<DIM> {
+    /// The state at `t` (s) in the step from `t_prev` to `t_now` that ended at `y_now`, into
+    /// `out`, as the scalar method's `interpolate` gives it (the step's ends as stored).
+    pub fn value(&self, t: f64, t_prev: f64, t_now: f64, y_now: &[f64; DIM], out: &mut [f64]) {
+        match self {
+            LaneInterpolant::Dopri5(cont) => {
+                dopri5::dense_value(t, t_prev, t_now, y_now, cont, out)
+            }
+            LaneInterpolant::Dop853(cont) => {
+                if t_now - t_prev == 0.0 || t == t_now {
+                    out.copy_from_slice(y_now);
+                } else if t == t_prev {
+                    out.copy_from_slice(&cont[0]);
+                } else {
+                    dop853::dense_interior(t, t_prev, t_now, cont, out);
+                }
+            }
+        }
+    }
+}
+
+/// A method's stages in lanes and the arithmetic of its step, as the engine calls them.
+pub(crate) trait LaneMethod<L: Lane, const DIM: usize> {
+    /// The step-size controller's settings (the scalar method's).
+    const CONTROL: StepControl;
+    /// Right-hand-side evaluations of an attempt's stages ([`LaneMethod::attempt`]).
+    const ATTEMPT_EVALUATIONS: f64;
+    /// Right-hand-side evaluations of the dense-output stages
+    /// ([`LaneMethod::dense_stages`]; 0: the dense output needs none).
+    const DENSE_EVALUATIONS: f64;
+    /// Every stage zero.
+    fn zeroed() -> Self;
+    /// The first stage, f at the step's start (kept across steps: first same as last).
+    fn first_stage(&mut self) -> &mut [L; DIM];
+    /// The initial step (s) from `(t, y)` with the first stage in place, for a span `span`
+    /// and a cap `h_max` (s), as the scalar method chooses it; evaluates `rhs` once.
+    #[allow(clippy::too_many_arguments)]
+    fn initial_step(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        y: &[L; DIM],
+        stage: &mut [L; DIM],
+        tolerances: (L, L),
+        h_max: L,
+        span: L,
+    ) -> L;
+    /// The stages of a step `h` (s) from `(t, y)`, the solution into `y_new`; returns the
+    /// step's scaled error (≤ 1 passes; non-finite if the stages were).
+    #[allow(clippy::too_many_arguments)]
+    fn attempt(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        h: L,
+        y: &[L; DIM],
+        y_new: &mut [L; DIM],
+        stage: &mut [L; DIM],
+        tolerances: (L, L),
+    ) -> L;
+    /// Whether a step that passed its error test evaluates a stage at its end
+    /// ([`LaneMethod::end_stage`]).
+    const END_STAGE: bool;
+    /// The stage at the end `(t_new, y_new)` of a step that passed its error test; returns
+    /// the lanes where it is finite.
+    fn end_stage(&mut self, rhs: &mut impl StageRhs<L>, t_new: L, y_new: &[L; DIM]) -> L::Mask;
+    /// The error's factor in the step-size control.
+    fn error_factor(err: L) -> L;
+    /// After an attempt: the lanes of `accept` take the new state `y_new` into `y` and the
+    /// next step's first stage (first same as last); with `observed`, the attempt's first
+    /// stage is kept for its dense output.
+    fn accept(&mut self, accept: L::Mask, observed: bool, y: &mut [L; DIM], y_new: &[L; DIM]);
+    /// The dense-output stages of the last attempted step `h` (s) from `(t, y)`, for every
+    /// lane; returns the lanes where they are finite.
+    fn dense_stages(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        h: L,
+        y: &[L; DIM],
+        stage: &mut [L; DIM],
+    ) -> L::Mask;
+    /// The dense output at `t` (s) strictly inside the last attempted step `h` from
+    /// `(t_prev, y)` to `(t_now, y_new)`, into `out` (the dense stages evaluated).
+    #[allow(clippy::too_many_arguments)]
+    fn dense_interior(
+        &self,
+        h: L,
+        t: L,
+        t_prev: L,
+        t_now: L,
+        y: &[L; DIM],
+        y_new: &[L; DIM],
+        out: &mut [L; DIM],
+    );
+    /// Lane `i`'s dense output over the last attempted step `h` (s) from `y` to `y_new`
+    /// (that lane's values), as the scalar method forms it.
+    fn interpolant(
+        &self,
+        i: usize,
+        h: f64,
+        y: &[f64; DIM],
+        y_new: &[f64; DIM],
+    ) -> LaneInterpolant<DIM>;
+}
+
+/// A method at every lane type: what the engine is instantiated with.
+pub(crate) trait MethodFamily {
+    /// The method's stages in lanes of type `L`.
+    type In<L: Lane, const DIM: usize>: LaneMethod<L, DIM>;
+}
+
+/// Lane `i` of each of `stages`, as `f64`.
+#[inline(always)]
+fn gather<L: Lane, const DIM: usize, const S: usize>(
+    stages: [&[L; DIM]; S],
+    i: usize,
+) -> [[f64; DIM]; S] {
+    let mut out = [[0.0; DIM]; S];
+    for (o, s) in out.iter_mut().zip(stages) {
+        L::gather_lane(s, i, o);
+    }
+    out
+}
+
+/// dopri5 in lanes.
+pub(crate) enum Dopri5 {}
+
+impl MethodFamily for Dopri5 {
+    type In<L: Lane, const DIM: usize> = Dopri5Lanes<L, DIM>;
+}
+
+/// dopri5's seven stages in lanes, and the first stage of the last attempt (for its dense
+/// output once `k[0]` holds the next step's).
+pub(crate) struct Dopri5Lanes<L: Lane, const DIM: usize> {
+    k: [[L; DIM]; 7],
+    k_start: [L; DIM],
+}
+
+impl<L: Lane, const DIM: usize> Dopri5Lanes<L, DIM> {
+    /// The last attempt's stages as its dense output reads them.
+    #[inline(always)]
+    fn step_stages(&self) -> [&[L; DIM]; 7] {
+        let [_, k2, k3, k4, k5, k6, k7] = &self.k;
+        [&self.k_start, k2, k3, k4, k5, k6, k7]
+    }
+}
+
+impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
+    const CONTROL: StepControl = dopri5::CONTROL;
+    const ATTEMPT_EVALUATIONS: f64 = 6.0;
+    const DENSE_EVALUATIONS: f64 = 0.0;
+    const END_STAGE: bool = false;
+
+    #[inline(always)]
+    fn zeroed() -> Self {
+        let z = L::splat(0.0);
+        Dopri5Lanes {
+            k: [[z; DIM]; 7],
+            k_start: [z; DIM],
+        }
+    }
+
+    #[inline(always)]
+    fn first_stage(&mut self) -> &mut [L; DIM] {
+        &mut self.k[0]
+    }
+
+    #[inline(always)]
+    fn initial_step(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        y: &[L; DIM],
+        stage: &mut [L; DIM],
+        (atol, rtol): (L, L),
+        h_max: L,
+        span: L,
+    ) -> L {
+        let [k1, k2, ..] = &mut self.k;
+        dopri5::initial_step(rhs, t, y, k1, k2, stage, atol, rtol, h_max, span)
+    }
+
+    #[inline(always)]
+    fn attempt(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        h: L,
+        y: &[L; DIM],
+        y_new: &mut [L; DIM],
+        stage: &mut [L; DIM],
+        (atol, rtol): (L, L),
+    ) -> L {
+        dopri5::stages(rhs, t, h, y, &mut self.k, stage, y_new);
+        dopri5::error_norm(h, &self.k, y, y_new, atol, rtol)
+    }
+
+    #[inline(always)]
+    fn end_stage(&mut self, _: &mut impl StageRhs<L>, _: L, _: &[L; DIM]) -> L::Mask {
+        L::Mask::splat(true)
+    }
+
+    #[inline(always)]
+    fn error_factor(err: L) -> L {
+        dopri5::error_factor(err)
+    }
+
+    #[inline(always)]
+    fn accept(&mut self, accept: L::Mask, observed: bool, y: &mut [L; DIM], y_new: &[L; DIM]) {
+        if observed {
+            self.k_start = self.k[0];
+        }
+        for j in 0..DIM {
+            y[j] = L::select(accept, y_new[j], y[j]);
+            // First same as last: the last stage is f at the new point.
+            self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
+        }
+    }
+
+    #[inline(always)]
+    fn dense_stages(
+        &mut self,
+        _: &mut impl StageRhs<L>,
+        _: L,
+        _: L,
+        _: &[L; DIM],
+        _: &mut [L; DIM],
+    ) -> L::Mask {
+        L::Mask::splat(true)
+    }
+
+    #[inline(always)]
+    fn dense_interior(
+        &self,
+        h: L,
+        t: L,
+        t_prev: L,
+        t_now: L,
+        y: &[L; DIM],
+        y_new: &[L; DIM],
+        out: &mut [L; DIM],
+    ) {
+        // What the caller does not read of the coefficients is dropped by the compiler.
+        let mut cont = [[L::splat(0.0); DIM]; 5];
+        dopri5::dense_coefficients(h, &self.step_stages(), y, y_new, &mut cont);
+        dopri5::dense_interior(t, t_prev, t_now, &cont, out);
+    }
+
+    fn interpolant(
+        &self,
+        i: usize,
+        h: f64,
+        y: &[f64; DIM],
+        y_new: &[f64; DIM],
+    ) -> LaneInterpolant<DIM> {
+        let k = gather(self.step_stages(), i);
+        let mut cont = [[0.0; DIM]; 5];
+        dopri5::dense_coefficients(h, &k, y, y_new, &mut cont);
+        LaneInterpolant::Dopri5(cont)
+    }
+}
+
+/// dop853 in lanes.
+pub(crate) enum Dop853 {}
+
+impl MethodFamily for Dop853 {
+    type In<L: Lane, const DIM: usize> = Dop853Lanes<L, DIM>;
+}
+
+/// dop853's sixteen stages in lanes (1–12 of the step, 13 at its end, 14–16 of its dense
+/// output), and the first stage of the last attempt (once `k[0]` holds the next step's).
+pub(crate) struct Dop853Lanes<L: Lane, const DIM: usize> {
+    k: [[L; DIM]; 16],
+    k_start: [L; DIM],
+}
+
+impl<L: Lane, const DIM: usize> Dop853Lanes<L, DIM> {
+    /// The last attempt's stages as its dense output reads them.
+    #[inline(always)]
+    fn step_stages(&self) -> [&[L; DIM]; 16] {
+        let k = &self.k;
+        [
+            &self.k_start,
+            &k[1],
+            &k[2],
+            &k[3],
+            &k[4],
+            &k[5],
+            &k[6],
+            &k[7],
+            &k[8],
+            &k[9],
+            &k[10],
+            &k[11],
+            &k[12],
+            &k[13],
+            &k[14],
+            &k[15],
+        ]
+    }
+}
+
+/// Whether every component of `v` is finite, per lane.
+#[inline(always)]
+fn all_finite<L: Lane>(v: &[L]) -> L::Mask {
+    v.iter()
+        .fold(L::Mask::splat(true), |m, &x| m & x.is_finite())
+}
+
+impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
+    const CONTROL: StepControl = dop853::CONTROL;
+    const ATTEMPT_EVALUATIONS: f64 = 11.0;
+    const DENSE_EVALUATIONS: f64 = 3.0;
+    const END_STAGE: bool = true;
+
+    #[inline(always)]
+    fn zeroed() -> Self {
+        let z = L::splat(0.0);
+        Dop853Lanes {
+            k: [[z; DIM]; 16],
+            k_start: [z; DIM],
+        }
+    }
+
+    #[inline(always)]
+    fn first_stage(&mut self) -> &mut [L; DIM] {
+        &mut self.k[0]
+    }
+
+    #[inline(always)]
+    fn initial_step(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        y: &[L; DIM],
+        stage: &mut [L; DIM],
+        tolerances: (L, L),
+        h_max: L,
+        span: L,
+    ) -> L {
+        let [k1, k2, ..] = &mut self.k;
+        dop853::initial_step(
+            rhs,
+            &PlainCombine,
+            t,
+            y,
+            k1,
+            k2,
+            stage,
+            tolerances,
+            h_max,
+            span,
+        )
+    }
+
+    #[inline(always)]
+    fn attempt(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        h: L,
+        y: &[L; DIM],
+        y_new: &mut [L; DIM],
+        stage: &mut [L; DIM],
+        (atol, rtol): (L, L),
+    ) -> L {
+        dop853::stages(rhs, &PlainCombine, t, h, y, &mut self.k, stage);
+        let k = &self.k;
+        let stages = [&k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11]].map(|s| &s[..]);
+        let z = L::splat(0.0);
+        let (mut scaled3, mut scaled5) = ([z; DIM], [z; DIM]);
+        dop853::solution_and_errors(
+            (h, atol, rtol),
+            y,
+            stages,
+            y_new,
+            &mut scaled3,
+            &mut scaled5,
+        );
+        dop853::error_estimate(h, &scaled3, &scaled5)
+    }
+
+    #[inline(always)]
+    fn end_stage(&mut self, rhs: &mut impl StageRhs<L>, t_new: L, y_new: &[L; DIM]) -> L::Mask {
+        rhs.eval(t_new, y_new, &mut self.k[12]);
+        all_finite(&self.k[12])
+    }
+
+    #[inline(always)]
+    fn error_factor(err: L) -> L {
+        dop853::error_factor(err)
+    }
+
+    #[inline(always)]
+    fn accept(&mut self, accept: L::Mask, observed: bool, y: &mut [L; DIM], y_new: &[L; DIM]) {
+        if observed {
+            self.k_start = self.k[0];
+        }
+        for j in 0..DIM {
+            y[j] = L::select(accept, y_new[j], y[j]);
+            // First same as last: stage 13 is f at the new point.
+            self.k[0][j] = L::select(accept, self.k[12][j], self.k[0][j]);
+        }
+    }
+
+    #[inline(always)]
+    fn dense_stages(
+        &mut self,
+        rhs: &mut impl StageRhs<L>,
+        t: L,
+        h: L,
+        y: &[L; DIM],
+        stage: &mut [L; DIM],
+    ) -> L::Mask {
+        // The step's first stage back in place while its dense stages are evaluated.
+        std::mem::swap(&mut self.k[0], &mut self.k_start);
+        dop853::dense_stages(rhs, &PlainCombine, t, h, y, &mut self.k, stage);
+        std::mem::swap(&mut self.k[0], &mut self.k_start);
+        all_finite(&self.k[13]) & all_finite(&self.k[14]) & all_finite(&self.k[15])
+    }
+
+    #[inline(always)]
+    fn dense_interior(
+        &self,
+        h: L,
+        t: L,
+        t_prev: L,
+        t_now: L,
+        y: &[L; DIM],
+        y_new: &[L; DIM],
+        out: &mut [L; DIM],
+    ) {
+        let mut cont = [[L::splat(0.0); DIM]; 8];
+        dop853::dense_coefficients(h, y, y_new, &self.step_stages(), &mut cont);
+        dop853::dense_interior(t, t_prev, t_now, &cont, out);
+    }
+
+    fn interpolant(
+        &self,
+        i: usize,
+        h: f64,
+        y: &[f64; DIM],
+        y_new: &[f64; DIM],
+    ) -> LaneInterpolant<DIM> {
+        let k = gather(self.step_stages(), i);
+        let mut cont = [[0.0; DIM]; 8];
+        dop853::dense_coefficients(h, y, y_new, &k, &mut cont);
+        LaneInterpolant::Dop853(cont)
+    }
+}
