@@ -1,4 +1,5 @@
-//! The lockstep dopri5 ensemble: W runs of one class integrated at once, one per lane
+//! The lockstep ensemble (dopri5 or dop853, `lanes::methods`): W runs of one class integrated
+//! at once, one per lane
 //! ([`Lane`]), whatever the class ([`LaneRun`]: one run's parameters and start; its
 //! [`LaneSystem`]: the runs' parameters in lanes, their right-hand side and observation).
 //!
@@ -8,12 +9,13 @@
 //! and accelerated solving of differential equations on multiple GPU platforms", Comput.
 //! Methods Appl. Mech. Eng. 419 (2024) 116591); the decisions are taken per lane under masks.
 //! A lane whose run has ended takes the next run. The arithmetic is the scalar path's, generic
-//! over the lane (dopri5's stages, error norm and controller in `integrate::dopri5`; the
-//! class's right-hand side and observation, which its [`LaneSystem`] writes with the scalar
-//! path's operations), so each lane's steps, rejections, right-hand-side count and final state
-//! are bit for bit those of the scalar `Dopri5` on that run's `Spacecraft`, stepped to the
-//! same end time. The engine knows no class: a class joins the lanes by implementing the two
-//! traits ([`super::damper`], the nutation-damper class, is the first).
+//! over the lane (the method's stages, error estimate and controller in `integrate::dopri5`
+//! and `integrate::dop853`; the class's right-hand side and observation, which its
+//! [`LaneSystem`] writes with the scalar path's operations), so each lane's steps, rejections,
+//! right-hand-side count and final state are bit for bit those of the scalar method on that
+//! run's `Spacecraft`, stepped to the same end time. The engine knows no class: a class joins
+//! the lanes by implementing the two traits ([`super::damper`], the nutation-damper class, and
+//! [`super::energy_sink`], a rigid body with an energy sink).
 //!
 //! [`integrate_runs`] picks the engine at run time: eight f64 lanes compiled for AVX-512
 //! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
@@ -150,7 +152,7 @@ pub struct GridAngle {
 }
 
 /// The state at one time of the output grid inside a step, from the step's dense output (as
-/// [`LaneStep::interpolate`] gives it), and its observation.
+/// [`LaneInterpolant::value`] gives it), and its observation.
 #[derive(Debug, Clone, Copy)]
 pub struct LaneSample<const DIM: usize> {
     /// The grid time (s): k / `sample_rate`.

@@ -12,16 +12,17 @@
 //! The right-hand sides and the stepper arithmetic that the ensemble integrators share with
 //! the scalar path are written once, generic over `Lane`: at `f64` they are the code the
 //! scalar path runs (the spring–mass damper's closed form, the hub's quaternion kinematics,
-//! dopri5's stages, error norm and step-size control), at `F64x4` (and the eight-lane AVX-512
+//! dopri5's and dop853's stages, error estimates and step-size control), at `F64x4` (and the eight-lane AVX-512
 //! type) the code of the lanes.
 //!
 //! Layout: [`f64x4`] (four lanes as a plain array, and its mask), `f64x8` (eight lanes in an
 //! AVX-512 register, x86-64 only, crate-private), [`linalg`] (3-vectors,
 //! 3 × 3 products, the SPD inverse and the quaternion rate, in lanes), [`elementary`] (the
 //! arctangent and the power that the monitor and the step-size control call every step, in
-//! lanes and at f64 alike), [`ensemble`] (the lockstep dopri5 ensemble, with the AVX2 and
+//! lanes and at f64 alike), [`ensemble`] (the lockstep ensemble, with the AVX2 and
 //! AVX-512 dispatch, generic over the class of runs it integrates: [`ensemble::LaneRun`] and
-//! [`ensemble::LaneSystem`]), [`damper`] (the nutation-damper class). docs/montecarlo.md,
+//! [`ensemble::LaneSystem`]), `methods` (dopri5 and dop853 in lanes), [`damper`] (the
+//! nutation-damper class), [`energy_sink`] (a rigid body with an energy sink). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;
