@@ -7,7 +7,6 @@
 //! those of the scalar `Dopri5` on that run's `Spacecraft` (tests/lanes_damper.rs compares
 //! them).
 
-use super::elementary::half_plane_atan2;
 use super::ensemble::{LaneObservation, LaneRun, LaneSystem};
 use super::{Lane, linalg};
 use crate::effectors::spring_mass::{SpringMass, SpringMassLanes};
@@ -164,16 +163,14 @@ impl<L: Lane> LaneSystem<L, DIM, DamperRun> for DamperLanes<L> {
     /// `(2 (u × v) w + u × t) + v`; the damper's closed-form momentum, then the hub's
     /// translation. The sums start from zero as the scalar sums do (so −0 becomes +0). Then
     /// |H| and the nutation angle (as `Observation::from_invariants` takes them; the
-    /// arctangent is [`half_plane_atan2`], the scalar path's too).
+    /// arctangent is [`super::elementary::half_plane_atan2`], the scalar path's too; both by
+    /// [`LaneObservation::of_hub`]).
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
         use linalg::cross;
         let zero = L::splat(0.0);
         let half = L::splat(0.5);
         let w = [y[0], y[1], y[2]];
-        let (qw, qi, qj, qk) = (y[3], y[4], y[5], y[6]);
-        let q_norm = ((qi * qi + qk * qk) + (qj * qj + qw * qw)).sqrt();
-        let attitude = [qw / q_norm, qi / q_norm, qj / q_norm, qk / q_norm];
         let i = &self.hub_inertia;
         // hub_inertia[c][r] is I(r, c).
         let iw: [L; 3] = linalg::each3(|r| i[0][r] * w[0] + i[1][r] * w[1] + i[2][r] * w[2]);
@@ -203,24 +200,12 @@ impl<L: Lane> LaneSystem<L, DIM, DamperRun> for DamperLanes<L> {
         }
         let lin2 = linear[0] * linear[0] + linear[1] * linear[1] + linear[2] * linear[2];
         kinetic = L::select(moving, kinetic - half * lin2 / mass, kinetic);
-        let axis = [attitude[1], attitude[2], attitude[3]];
-        let two = L::splat(2.0);
-        let t = cross(axis, h);
-        let t = [t[0] * two, t[1] * two, t[2] * two];
-        let ut = cross(axis, t);
-        let h_inertial: [L; 3] = linalg::each3(|k| t[k] * attitude[0] + ut[k] + h[k]);
-        let a = self.spin_axis;
-        LaneObservation {
-            attitude,
-            q_norm_error: q_norm - L::splat(1.0),
-            h_body: h,
-            h_inertial,
-            kinetic_energy: kinetic,
-            elastic_energy: zero + half * d.stiffness * q * q,
-            dissipated_energy: zero + y[9],
-            dissipation_power: zero + d.damping * u * u,
-            h_norm: linalg::norm(h),
-            nutation_angle: half_plane_atan2(linalg::norm(cross(a, h)), linalg::dot(a, h)),
-        }
+        let energies = [
+            kinetic,
+            zero + half * d.stiffness * q * q,
+            zero + y[9],
+            zero + d.damping * u * u,
+        ];
+        LaneObservation::of_hub([y[3], y[4], y[5], y[6]], h, energies, self.spin_axis)
     }
 }

@@ -10,7 +10,6 @@
 //! The torque is τ = −c ω⊥, ω⊥ = ω − (ω·Ĥ) Ĥ with Ĥ = Iω/|Iω| (docs/effectors.md,
 //! "energy_sink"); the one state beside ω and q is the dissipated energy, Ė = c |ω⊥|².
 
-use super::elementary::half_plane_atan2;
 use super::ensemble::{LaneObservation, LaneRun, LaneSystem};
 use super::{Lane, LaneMask, linalg};
 use crate::effectors::energy_sink::EnergySink;
@@ -155,35 +154,18 @@ impl<L: Lane> LaneSystem<L, DIM, SinkRun> for SinkLanes<L> {
     /// then |H| and the nutation angle.
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
-        use linalg::cross;
         let zero = L::splat(0.0);
-        let half = L::splat(0.5);
         let w = [y[0], y[1], y[2]];
-        let (qw, qi, qj, qk) = (y[3], y[4], y[5], y[6]);
-        let q_norm = ((qi * qi + qk * qk) + (qj * qj + qw * qw)).sqrt();
-        let attitude = [qw / q_norm, qi / q_norm, qj / q_norm, qk / q_norm];
         let iw = linalg::mat_vec(&self.hub_inertia, w);
         let h: [L; 3] = linalg::each3(|k| iw[k] + zero);
-        let kinetic = half * linalg::dot(w, iw) + zero;
-        let axis = [attitude[1], attitude[2], attitude[3]];
-        let two = L::splat(2.0);
-        let t = cross(axis, h);
-        let t = [t[0] * two, t[1] * two, t[2] * two];
-        let ut = cross(axis, t);
-        let h_inertial: [L; 3] = linalg::each3(|k| t[k] * attitude[0] + ut[k] + h[k]);
-        let a = self.spin_axis;
-        LaneObservation {
-            attitude,
-            q_norm_error: q_norm - L::splat(1.0),
-            h_body: h,
-            h_inertial,
-            kinetic_energy: kinetic,
-            elastic_energy: zero + zero,
-            dissipated_energy: zero + y[7],
-            dissipation_power: zero + self.power(self.transverse_rate(w)),
-            h_norm: linalg::norm(h),
-            nutation_angle: half_plane_atan2(linalg::norm(cross(a, h)), linalg::dot(a, h)),
-        }
+        let kinetic = L::splat(0.5) * linalg::dot(w, iw) + zero;
+        let energies = [
+            kinetic,
+            zero + zero,
+            zero + y[7],
+            zero + self.power(self.transverse_rate(w)),
+        ];
+        LaneObservation::of_hub([y[3], y[4], y[5], y[6]], h, energies, self.spin_axis)
     }
 }
 

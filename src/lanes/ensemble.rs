@@ -194,6 +194,49 @@ pub struct LaneObservation<T = f64> {
 }
 
 impl<L: Lane> LaneObservation<L> {
+    /// The observation of a hub whose integrated quaternion is `q` (w, x, y, z; not yet of
+    /// unit norm) and whose system has angular momentum `h` (body axes, N m s), with the
+    /// energies `[kinetic, elastic, dissipated, dissipation power]` (J, J, J, W), the nutation
+    /// angle measured from `spin_axis` (body axes, unit), with the operations of
+    /// `observe::invariants` and `Observation::from_invariants`: nalgebra's 4-vector norm
+    /// `(x² + z²) + (y² + w²)`, its rotation `(2 (u × h) w + u × t) + h`, its 3-vector norm,
+    /// and the arctangent of [`super::elementary::half_plane_atan2`].
+    #[inline(always)]
+    pub fn of_hub(q: [L; 4], h: [L; 3], energies: [L; 4], spin_axis: [L; 3]) -> Self {
+        use linalg::cross;
+        let [qw, qi, qj, qk] = q;
+        let q_norm = ((qi * qi + qk * qk) + (qj * qj + qw * qw)).sqrt();
+        let attitude = [qw / q_norm, qi / q_norm, qj / q_norm, qk / q_norm];
+        let axis = [attitude[1], attitude[2], attitude[3]];
+        let two = L::splat(2.0);
+        let t = cross(axis, h);
+        let t = [t[0] * two, t[1] * two, t[2] * two];
+        let ut = cross(axis, t);
+        let h_inertial: [L; 3] = linalg::each3(|k| t[k] * attitude[0] + ut[k] + h[k]);
+        let [
+            kinetic_energy,
+            elastic_energy,
+            dissipated_energy,
+            dissipation_power,
+        ] = energies;
+        let a = spin_axis;
+        LaneObservation {
+            attitude,
+            q_norm_error: q_norm - L::splat(1.0),
+            h_body: h,
+            h_inertial,
+            kinetic_energy,
+            elastic_energy,
+            dissipated_energy,
+            dissipation_power,
+            h_norm: linalg::norm(h),
+            nutation_angle: super::elementary::half_plane_atan2(
+                linalg::norm(cross(a, h)),
+                linalg::dot(a, h),
+            ),
+        }
+    }
+
     /// Lane `i`'s values.
     #[inline(always)]
     fn lane(&self, i: usize) -> LaneObservation {

@@ -76,8 +76,11 @@ impl<const DIM: usize> StepView for LaneView<'_, DIM> {
     }
     fn prepare_interpolation(&mut self, _: &Spacecraft) -> bool {
         let finite = self.rest.prepare_interpolation();
-        // An interpolant formed before the dense stages were is formed again.
-        self.interpolant.take();
+        // An interpolant formed before the dense stages were is formed again (set anew rather
+        // than taken: `take` would copy it out).
+        if self.interpolant.get().is_some() {
+            self.interpolant = OnceCell::new();
+        }
         finite
     }
     fn stats(&self) -> Stats {
