@@ -21,6 +21,7 @@
 //! The tests compare it with the library over 10⁶ arguments: the largest difference is
 //! 1.1·10⁻¹⁶, one unit in the last place of a number in [0.5, 1).
 
+use crate::lanes::{Lane, LaneMask};
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
@@ -135,6 +136,45 @@ pub fn sin_cos_lanes<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
     out
 }
 
+/// `(sin x, cos x)` of each lane of `x` (one run per lane in a campaign's lanes):
+/// [`sin_cos`]'s operations on each lane, bit for bit. The reduction's rounding to the table's
+/// node and the table's loads go lane by lane; the rest runs in the lanes. A lane out of the
+/// reduction's range (or not a number) sends every lane to [`sin_cos`].
+#[inline(always)]
+pub fn sin_cos_in_lanes<L: Lane>(x: L) -> (L, L) {
+    let y = x * L::splat(STEPS as f64 / TAU);
+    // Not below the limit: huge, infinite or not a number.
+    if !(y.abs().less_than(L::splat(K_MAX))).all() {
+        let (mut s, mut c) = (x, x);
+        for i in 0..L::WIDTH {
+            let (si, ci) = sin_cos(x.lane(i));
+            s = s.with_lane(i, si);
+            c = c.with_lane(i, ci);
+        }
+        return (s, c);
+    }
+    let t = table();
+    let (mut k, mut s_j, mut c_j) = (x, x, x);
+    for i in 0..L::WIDTH {
+        let yi = y.lane(i);
+        let k_int = (yi + 0.5f64.copysign(yi)) as i64;
+        k = k.with_lane(i, k_int as f64);
+        let (s, c) = t.values[(k_int & (STEPS as i64 - 1)) as usize];
+        s_j = s_j.with_lane(i, s);
+        c_j = c_j.with_lane(i, c);
+    }
+    let c = L::splat;
+    let r = ((x - k * c(t.d1)) - k * c(t.d2)) - k * c(t.d3);
+    let r2 = r * r;
+    let sin_r = r + r * r2 * (c(-1.0 / 6.0) + r2 * (c(1.0 / 120.0) + r2 * c(-1.0 / 5040.0)));
+    let cos_r_minus_1 =
+        r2 * (c(-0.5) + r2 * (c(1.0 / 24.0) + r2 * (c(-1.0 / 720.0) + r2 * c(1.0 / 40320.0))));
+    (
+        s_j + (s_j * cos_r_minus_1 + c_j * sin_r),
+        c_j + (c_j * cos_r_minus_1 - s_j * sin_r),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -198,6 +238,15 @@ mod tests {
             let (s, c) = sin_cos_lanes(x);
             for i in 0..8 {
                 assert_eq!(bits((s[i], c[i])), bits(sin_cos(x[i])), "{}", x[i]);
+            }
+            // The same arguments four at a time in the campaigns' lanes, and one at a time.
+            for half in x.chunks(4) {
+                let lanes = crate::lanes::F64x4([half[0], half[1], half[2], half[3]]);
+                let (s, c) = sin_cos_in_lanes(lanes);
+                for (i, &v) in half.iter().enumerate() {
+                    assert_eq!(bits((s.lane(i), c.lane(i))), bits(sin_cos(v)), "{v}");
+                    assert_eq!(bits(sin_cos_in_lanes(v)), bits(sin_cos(v)), "{v}");
+                }
             }
         }
     }

@@ -1355,7 +1355,7 @@ pub(crate) fn spd_inverse3(a: f64, b: f64, c: f64, d: f64, e: f64, f: f64) -> Op
 /// builds computed wrong accelerations in one scene (docs/benchmarks.md, "Wrong accelerations
 /// from some release builds"); the call costs about 1% of Explorer 1's instructions.
 #[inline(never)]
-fn schur_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
+pub(crate) fn schur_solve6(m: &Matrix6<f64>, f: &Vector6<f64>) -> Option<Vector6<f64>> {
     let a_inv = spd_inverse3(
         m[(0, 0)],
         m[(1, 0)],
