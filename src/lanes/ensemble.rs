@@ -127,6 +127,10 @@ pub struct LaneStep {
     /// the nutation angle there (of an observed integration; the state and the whole
     /// observation there: [`StepInLanes::sample`]).
     pub sample: Option<GridAngle>,
+    /// The later times of the run's output grid strictly inside the step, in order, with the
+    /// nutation angle at each (of an observed integration whose grid observation is
+    /// [`GridObservation::NutationAngle`]; empty otherwise).
+    pub later_samples: Vec<GridAngle>,
 }
 
 /// What an observed integration computes at the output grid time inside a step.
@@ -699,6 +703,10 @@ struct Lanes<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> 
     /// The lanes whose last accepted step holds a grid time strictly inside it, with that
     /// time, the state there and its observation, when observed.
     sample: Option<SampleLanes<L, DIM>>,
+    /// The later grid times strictly inside the last accepted step, one entry per further
+    /// time: the lanes that have it, the time and the nutation angle there (with
+    /// [`GridObservation::NutationAngle`]).
+    later: Vec<(L::Mask, L, L)>,
     /// Work counters, as exact integers in f64.
     steps: L,
     rejected: L,
@@ -743,6 +751,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             sample_rate: z,
             next_sample: z,
             sample: None,
+            later: Vec::new(),
             steps: z,
             rejected: z,
             rhs_evaluations: z,
@@ -830,6 +839,15 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             }),
             _ => None,
         };
+        step.later_samples.clear();
+        for (due, t, angle) in &self.later {
+            if due.test(i) {
+                step.later_samples.push(GridAngle {
+                    t: read(t, i),
+                    nutation_angle: read(angle, i),
+                });
+            }
+        }
         step.stats = Stats {
             steps: read(&self.steps, i) as u64,
             rejected_steps: read(&self.rejected, i) as u64,
@@ -939,28 +957,32 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     /// output grid strictly inside it, the state there by the step's dense output (the
     /// operations of `dopri5::dense_value`) and its observation; then the next grid index
     /// past the step's end, as the run monitor advances it when it samples up to there. A
-    /// grid time at the step's end is the end observation, and a second one inside the same
-    /// step is left to the monitor.
+    /// grid time at the step's end is the end observation. The later grid times inside the
+    /// same step: with [`GridObservation::NutationAngle`], the nutation angle at each (a long
+    /// dop853 step holds many); otherwise they are left to the monitor.
     #[inline(always)]
     fn sample_inside(&mut self, accepted: L::Mask) {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let gridded = accepted & self.sample_rate.greater_than(zero);
         let t_k = self.next_sample / self.sample_rate;
         let due = gridded & t_k.less_than(self.t);
+        self.later.clear();
         self.sample = if due.any() {
             // The scalar monitor prepares the dense output of a step with a grid time inside.
             self.prepare_dense(due);
             let mut y = [zero; DIM];
-            self.method.dense_interior(
-                self.h_step,
-                t_k,
-                self.t_prev,
-                self.t,
-                &self.y_start,
-                &self.y_new,
-                &mut y,
-            );
+            // Formed and read at once (the coefficients the observation does not need are
+            // dropped by the compiler).
+            let dense = self.method.dense(self.h_step, &self.y_start, &self.y_new);
+            M::dense_at(&dense, t_k, self.t_prev, self.t, &mut y);
             let observation = self.system.observe(&y);
+            // The later grid times k / rate inside the step (k an integer: exact sums).
+            let next = self.next_sample + one;
+            if self.grid == GridObservation::NutationAngle
+                && (gridded & (next / self.sample_rate).less_than(self.t)).any()
+            {
+                self.later_samples(gridded, next);
+            }
             Some(SampleLanes {
                 due,
                 t: t_k,
@@ -976,6 +998,29 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
                 break;
             }
             self.next_sample += L::select(passed, one, zero);
+        }
+    }
+
+    /// The nutation angle at the grid times k / rate, k = `first`, `first` + 1, …, strictly
+    /// inside the last accepted step of the lanes of `gridded`, into `later` (their dense
+    /// stages evaluated). Inlined (an out-of-line function would not have the engine's
+    /// instruction set), but apart from the first grid time's: most steps hold one at most.
+    #[inline(always)]
+    fn later_samples(&mut self, gridded: L::Mask, first: L) {
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        let dense = self.method.dense(self.h_step, &self.y_start, &self.y_new);
+        let mut k = first;
+        loop {
+            let t_j = k / self.sample_rate;
+            let due_j = gridded & t_j.less_than(self.t);
+            if !due_j.any() {
+                break;
+            }
+            let mut y_j = [zero; DIM];
+            M::dense_at(&dense, t_j, self.t_prev, self.t, &mut y_j);
+            let angle = self.system.observe(&y_j).nutation_angle;
+            self.later.push((due_j, t_j, angle));
+            k += one;
         }
     }
 

@@ -114,19 +114,14 @@ pub(crate) trait LaneMethod<L: Lane, const DIM: usize> {
         y: &[L; DIM],
         stage: &mut [L; DIM],
     ) -> L::Mask;
-    /// The dense output at `t` (s) strictly inside the last attempted step `h` from
-    /// `(t_prev, y)` to `(t_now, y_new)`, into `out` (the dense stages evaluated).
-    #[allow(clippy::too_many_arguments)]
-    fn dense_interior(
-        &self,
-        h: L,
-        t: L,
-        t_prev: L,
-        t_now: L,
-        y: &[L; DIM],
-        y_new: &[L; DIM],
-        out: &mut [L; DIM],
-    );
+    /// The dense-output coefficients of the last attempted step `h` (s) from `y` to `y_new`
+    /// (its dense stages evaluated), in lanes.
+    type Dense;
+    /// [`LaneMethod::Dense`] of the last attempted step.
+    fn dense(&self, h: L, y: &[L; DIM], y_new: &[L; DIM]) -> Self::Dense;
+    /// The dense output at `t` (s) strictly inside the step from `t_prev` to `t_now` whose
+    /// coefficients are `dense`, into `out`.
+    fn dense_at(dense: &Self::Dense, t: L, t_prev: L, t_now: L, out: &mut [L; DIM]);
     /// Lane `i`'s dense output over the last attempted step `h` (s) from `y` to `y_new`
     /// (that lane's values), as the scalar method forms it.
     fn interpolant(
@@ -264,21 +259,19 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
         L::Mask::splat(true)
     }
 
+    type Dense = [[L; DIM]; 5];
+
     #[inline(always)]
-    fn dense_interior(
-        &self,
-        h: L,
-        t: L,
-        t_prev: L,
-        t_now: L,
-        y: &[L; DIM],
-        y_new: &[L; DIM],
-        out: &mut [L; DIM],
-    ) {
+    fn dense(&self, h: L, y: &[L; DIM], y_new: &[L; DIM]) -> Self::Dense {
         // What the caller does not read of the coefficients is dropped by the compiler.
         let mut cont = [[L::splat(0.0); DIM]; 5];
         dopri5::dense_coefficients(h, &self.step_stages(), y, y_new, &mut cont);
-        dopri5::dense_interior(t, t_prev, t_now, &cont, out);
+        cont
+    }
+
+    #[inline(always)]
+    fn dense_at(dense: &Self::Dense, t: L, t_prev: L, t_now: L, out: &mut [L; DIM]) {
+        dopri5::dense_interior(t, t_prev, t_now, dense, out);
     }
 
     fn interpolant(
@@ -454,20 +447,18 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
         all_finite(&self.k[13]) & all_finite(&self.k[14]) & all_finite(&self.k[15])
     }
 
+    type Dense = [[L; DIM]; 8];
+
     #[inline(always)]
-    fn dense_interior(
-        &self,
-        h: L,
-        t: L,
-        t_prev: L,
-        t_now: L,
-        y: &[L; DIM],
-        y_new: &[L; DIM],
-        out: &mut [L; DIM],
-    ) {
+    fn dense(&self, h: L, y: &[L; DIM], y_new: &[L; DIM]) -> Self::Dense {
         let mut cont = [[L::splat(0.0); DIM]; 8];
         dop853::dense_coefficients(h, y, y_new, &self.step_stages(), &mut cont);
-        dop853::dense_interior(t, t_prev, t_now, &cont, out);
+        cont
+    }
+
+    #[inline(always)]
+    fn dense_at(dense: &Self::Dense, t: L, t_prev: L, t_now: L, out: &mut [L; DIM]) {
+        dop853::dense_interior(t, t_prev, t_now, dense, out);
     }
 
     fn interpolant(

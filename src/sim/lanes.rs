@@ -112,7 +112,14 @@ impl<const DIM: usize> StepView for LaneView<'_, DIM> {
             return Some(self.step.end_nutation_angle);
         }
         let sample = self.step.sample.as_ref()?;
-        (sample.t.to_bits() == t.to_bits()).then_some(sample.nutation_angle)
+        if sample.t.to_bits() == t.to_bits() {
+            return Some(sample.nutation_angle);
+        }
+        self.step
+            .later_samples
+            .iter()
+            .find(|s| s.t.to_bits() == t.to_bits())
+            .map(|s| s.nutation_angle)
     }
     fn end_observation(&self, sc: &Spacecraft, angles: bool) -> Option<Observation> {
         let (step, y) = (self.step, self.state());
