@@ -328,7 +328,9 @@ fn a_killed_shard_rerun_gives_the_identical_result() {
     let dir = scratch("killed-shard");
     let shard = |k: u32, out: &Path| {
         let mut cmd = polhode();
-        cmd.args(["montecarlo", CAMPAIGN, "--runs", "6000", "--seed", "9"])
+        // 20000 runs: a shard of 10000 lasts some 4 s in lanes on one thread, well past the
+        // kill at 0.4 s.
+        cmd.args(["montecarlo", CAMPAIGN, "--runs", "20000", "--seed", "9"])
             .args([
                 "--threads",
                 "1",
@@ -384,7 +386,7 @@ fn a_killed_shard_rerun_gives_the_identical_result() {
             "montecarlo",
             CAMPAIGN,
             "--runs",
-            "6000",
+            "20000",
             "--seed",
             "9",
             "-q",
@@ -398,7 +400,7 @@ fn a_killed_shard_rerun_gives_the_identical_result() {
     record(
         "faults",
         "shard killed (SIGKILL) and re-run",
-        "shard 1/2 of 6000 runs killed 0.4 s in, re-run into the same directory",
+        "shard 1/2 of 20000 runs killed 0.4 s in, re-run into the same directory",
         &Observed {
             code: Some(0),
             message: "the re-run shard's files equal a clean run's byte for byte; the merged \
