@@ -608,6 +608,27 @@ pub(crate) fn dense_interior<L: Lane, C: AsRef<[L]>>(
     }
 }
 
+/// The dense output at `t` (s) of the accepted step from `t_prev` to `t_now` that ended at
+/// `y_now`, from its coefficients `cont` ([`dense_coefficients`]; `cont[0]` is the state at
+/// the step's start), into `out`. The step's ends are returned as stored.
+#[inline(always)]
+pub(crate) fn dense_value<C: AsRef<[f64]>>(
+    t: f64,
+    t_prev: f64,
+    t_now: f64,
+    y_now: &[f64],
+    cont: &[C; 8],
+    out: &mut [f64],
+) {
+    if t_now - t_prev == 0.0 || t == t_now {
+        out.copy_from_slice(y_now);
+    } else if t == t_prev {
+        out.copy_from_slice(cont[0].as_ref());
+    } else {
+        dense_interior(t, t_prev, t_now, cont, out);
+    }
+}
+
 /// When [`Dop853`] evaluates the dense-output stages of an accepted step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum DenseOutput {
@@ -952,22 +973,13 @@ impl Stepper for Dop853 {
     /// the step if dense output was switched off ([`Dop853::with_dense_output`]), or deferred
     /// ([`Dop853::with_lazy_dense_output`]) and not prepared.
     fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let h = self.t - self.t_prev;
-        // The step's ends are returned as stored.
-        if h == 0.0 || t == self.t {
-            out.copy_from_slice(&self.y);
-            return;
-        }
-        if t == self.t_prev {
-            out.copy_from_slice(&self.cont[0]);
-            return;
-        }
+        let inside = self.t != self.t_prev && t != self.t && t != self.t_prev;
         assert!(
-            self.dense_ready,
+            !inside || self.dense_ready,
             "Dop853::interpolate inside a step needs dense output, which was switched off \
              (or, lazy, not prepared by `prepare_interpolation`)"
         );
-        dense_interior(t, self.t_prev, self.t, &self.cont, out);
+        dense_value(t, self.t_prev, self.t, &self.y, &self.cont, out);
     }
 }
 

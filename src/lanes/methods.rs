@@ -41,13 +41,7 @@ impl<const DIM: usize> LaneInterpolant<DIM> {
                 dopri5::dense_value(t, t_prev, t_now, y_now, cont, out)
             }
             LaneInterpolant::Dop853(cont) => {
-                if t_now - t_prev == 0.0 || t == t_now {
-                    out.copy_from_slice(y_now);
-                } else if t == t_prev {
-                    out.copy_from_slice(&cont[0]);
-                } else {
-                    dop853::dense_interior(t, t_prev, t_now, cont, out);
-                }
+                dop853::dense_value(t, t_prev, t_now, y_now, cont, out)
             }
         }
     }
