@@ -43,6 +43,7 @@ pub mod motor_wheel;
 pub mod particles;
 pub mod propellant_tank;
 pub mod rayleigh;
+pub mod rod_closed_form;
 pub mod rod_lanes;
 pub mod slosh_analog;
 pub mod slosh_pendulum;

@@ -11,6 +11,7 @@
 
 use super::hinged_rod::{HingeFreedom, HingedRod, add_hinge_mass};
 use super::particles::ParticleEffector;
+use super::rod_closed_form::{ROWS, RodConstants};
 use crate::model::{Effector, EffectorGroup, HubAcceleration, HubCoupling, HubState, Momentum};
 use crate::sincos::sin_cos_lanes;
 use nalgebra::{Matrix6, Vector3};
@@ -22,34 +23,16 @@ pub const LANES: usize = 4;
 /// One number per lane.
 type Lanes = [f64; LANES];
 
-/// Entries of W per rod: two rows of 7, W_k = [g_k, Cᵀ_k] / M_kk (as the rod's closed form
-/// keeps them; its L is 1).
-const ROWS: usize = 14;
-
 /// Sines and cosines of the lanes' flap angles, then of their lag angles.
 type Sines = ([f64; 2 * LANES], [f64; 2 * LANES]);
 
 /// A vector per lane: x, y and z components, each over the lanes.
 type LaneVectors = [Lanes; 3];
 
-fn lane(v: &LaneVectors, r: usize) -> Vector3<f64> {
-    Vector3::new(v[0][r], v[1][r], v[2][r])
-}
-
 fn set_lane(v: &mut LaneVectors, r: usize, value: &Vector3<f64>) {
     for (component, x) in v.iter_mut().zip(value.iter()) {
         component[r] = *x;
     }
-}
-
-/// A rod's direction ê, its derivatives ∂ê/∂θ_f and ∂ê/∂θ_l, and the lag circle's c and
-/// ∂c/∂θ_l (ê = cos θ_f c + sin θ_f n̂).
-struct Direction {
-    c: Vector3<f64>,
-    c_prime: Vector3<f64>,
-    e: Vector3<f64>,
-    e_f: Vector3<f64>,
-    e_l: Vector3<f64>,
 }
 
 /// Up to [`LANES`] flap–lag rods coupled in one call. Lanes past `count` repeat lane 0 with
@@ -157,26 +140,32 @@ impl RodLanes {
         (angles, sin_cos_lanes(both))
     }
 
-    /// Lane `r`'s ê and its derivatives (as `HingedRod::direction_at`), from the sines and
-    /// cosines of [`RodLanes::angles`].
+    /// Lane `r`'s rod as the closed form takes it.
     #[inline(always)]
-    fn direction(&self, (s, c): &Sines, r: usize) -> Direction {
-        let (sf, cf, sl, cl) = (s[r], c[r], s[LANES + r], c[LANES + r]);
-        let (rest, b, n) = (
-            lane(&self.rest, r),
-            lane(&self.binormal, r),
-            lane(&self.axis, r),
-        );
-        let c = cl * rest + sl * b;
-        let c_prime = -sl * rest + cl * b;
-        let e = cf * c + sf * n;
-        Direction {
-            c,
-            c_prime,
-            e,
-            e_f: -sf * c + cf * n,
-            e_l: cf * c_prime,
+    fn constants(&self, r: usize) -> RodConstants<f64> {
+        let at = |v: &LaneVectors| [v[0][r], v[1][r], v[2][r]];
+        RodConstants {
+            hinge: at(&self.hinge),
+            rest: at(&self.rest),
+            axis: at(&self.axis),
+            binormal: at(&self.binormal),
+            m1: self.m1[r],
+            m2: self.m2[r],
+            mu: self.mu[r],
+            hinge_mass: self.hinge_mass[r],
+            stiffness: [self.stiffness[0][r], self.stiffness[1][r]],
+            damping: [self.damping[0][r], self.damping[1][r]],
         }
+    }
+
+    /// Lane `r`'s angles and rates, and `[sin θ_f, cos θ_f, sin θ_l, cos θ_l]`, from
+    /// [`RodLanes::angles`].
+    #[inline(always)]
+    fn lane_angles(angles: &[Lanes; 4], (s, c): &Sines, r: usize) -> ([f64; 4], [f64; 4]) {
+        (
+            [angles[0][r], angles[1][r], angles[2][r], angles[3][r]],
+            [s[r], c[r], s[LANES + r], c[LANES + r]],
+        )
     }
 
     /// The groups of a spacecraft's flap–lag rods, [`LANES`] at a time in the order the
@@ -214,23 +203,17 @@ impl RodLanes {
     #[allow(clippy::needless_range_loop)] // lane loops index several arrays by lane
     #[inline(always)]
     fn momentum_lanes(&self, hub: &HubState, y: &[f64]) -> Momentum {
-        let omega = hub.omega;
+        let omega = [hub.omega.x, hub.omega.y, hub.omega.z];
         let (angles, sines) = self.angles(y);
         let mut sum = Momentum::default();
         for r in 0..self.count {
-            let Direction { e, e_f, e_l, .. } = self.direction(&sines, r);
-            let (m, m1, m2) = (self.hinge_mass[r] + self.mu[r], self.m1[r], self.m2[r]);
-            let h = lane(&self.hinge, r);
-            // As `HingedRod::momentum_closed_form`: v(s) = v_h + s v_ê.
-            let v_h = omega.cross(&h);
-            let v_e = omega.cross(&e) + angles[2][r] * e_f + angles[3][r] * e_l;
-            sum.mass += m;
-            sum.first_moment += m * h + m1 * e;
-            sum.linear += m * v_h + m1 * v_e;
-            sum.angular +=
-                m * h.cross(&v_h) + m1 * (h.cross(&v_e) + e.cross(&v_h)) + m2 * e.cross(&v_e);
-            sum.kinetic_energy += 0.5 * (m * v_h.norm_squared() + 2.0 * m1 * v_h.dot(&v_e))
-                + 0.5 * m2 * v_e.norm_squared();
+            let (a, s) = Self::lane_angles(&angles, &sines, r);
+            let m = self.constants(r).momentum(a, s, omega);
+            sum.mass += m.mass;
+            sum.first_moment += Vector3::from(m.first_moment);
+            sum.linear += Vector3::from(m.linear);
+            sum.angular += Vector3::from(m.angular);
+            sum.kinetic_energy += m.kinetic_energy;
         }
         sum
     }
@@ -255,53 +238,21 @@ impl RodLanes {
         // W, row entry by row entry, each over the lanes.
         let (rows, _) = scratch.split_at_mut(ROWS * LANES);
         let mut cos2 = [0.0; LANES];
+        let omega = [omega.x, omega.y, omega.z];
         for r in 0..LANES {
-            let [f, l, df, dl] = [angles[0][r], angles[1][r], angles[2][r], angles[3][r]];
-            let (sf, cf) = (sines.0[r], sines.1[r]);
-            let h = lane(&self.hinge, r);
-            let (m1, m2, mu) = (self.m1[r], self.m2[r], self.mu[r]);
-            let Direction {
-                c,
-                c_prime,
-                e,
-                e_f,
-                e_l,
-            } = self.direction(&sines, r);
-            let kappa = -cf * dl * dl * c - 2.0 * sf * df * dl * c_prime - df * df * e;
-            let c2 = e_l.norm_squared();
-            cos2[r] = c2;
-            let q_flap = -self.stiffness[0][r] * f - self.damping[0][r] * df;
-            let q_lag = -self.stiffness[1][r] * l - self.damping[1][r] * dl;
-            let joint = q_flap * e_f + (q_lag / c2) * e_l;
-            let e_rate = df * e_f + dl * e_l;
-            let relative = 2.0 * omega.cross(&e_rate) + kappa;
-            let omega_e = omega.dot(&e);
-            let lambda = omega_e * omega_e - w2 + e.dot(&relative);
-            let a_h = omega * omega.dot(&h) - w2 * h;
-            let hinge_force =
-                self.hinge_mass[r] * a_h + (mu * e.dot(&a_h) + m1 * lambda) * e + (m1 / m2) * joint;
-            let hinge_moment = h.cross(&hinge_force) + e.cross(&joint);
+            let (a, s) = Self::lane_angles(&angles, &sines, r);
+            let rod = self.constants(r).coupling(a, s, omega, w2);
+            cos2[r] = rod.cos2;
             let weight = self.weight[r];
-            set_lane(&mut force, r, &(weight * hinge_force));
-            set_lane(&mut moment, r, &(weight * hinge_moment));
-            let he = h.cross(&e);
-            for (i, x) in [e.x, e.y, e.z, he.x, he.y, he.z].into_iter().enumerate() {
-                v[i][r] = x;
+            for i in 0..3 {
+                force[i][r] = weight * rod.hinge_force[i];
+                moment[i][r] = weight * rod.hinge_moment[i];
             }
-            // W rows (as the rod's closed form).
-            let p2 = m1 * h + m2 * e;
-            let force_s = omega * omega.dot(&p2) - w2 * p2 + m2 * relative;
-            for (k, (j, mass_k, q_k)) in [(e_f, m2, q_flap), (e_l, m2 * c2, q_lag)]
-                .into_iter()
-                .enumerate()
-            {
-                let inv = 1.0 / mass_k;
-                let torque = p2.cross(&j);
-                rows[7 * k * LANES + r] = (q_k - j.dot(&force_s)) * inv;
-                for a in 0..3 {
-                    rows[(7 * k + 1 + a) * LANES + r] = m1 * j[a] * inv;
-                    rows[(7 * k + 4 + a) * LANES + r] = torque[a] * inv;
-                }
+            for i in 0..6 {
+                v[i][r] = rod.v[i];
+            }
+            for (row, x) in rod.rows.into_iter().enumerate() {
+                rows[row * LANES + r] = x;
             }
         }
         for i in 0..3 {
@@ -368,8 +319,8 @@ impl RodLanes {
                 lag_rate,
                 u_dot[0][r],
                 u_dot[1][r],
-                self.damping[0][r] * flap_rate * flap_rate
-                    + self.damping[1][r] * lag_rate * lag_rate,
+                self.constants(r)
+                    .dissipation_power([0.0, 0.0, flap_rate, lag_rate]),
             ]);
         }
     }
