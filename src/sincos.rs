@@ -35,8 +35,10 @@ const TAU_LO: f64 = 2.449_293_598_294_706_4e-16;
 const K_MAX: f64 = (1u64 << 27) as f64;
 
 struct Table {
-    /// `(sin, cos)(2πj/256)`.
-    values: [(f64, f64); STEPS],
+    /// `sin(2πj/256)`.
+    sines: [f64; STEPS],
+    /// `cos(2πj/256)`.
+    cosines: [f64; STEPS],
     /// `d = 2π/256` in three parts: `d₁ + d₂ + d₃`.
     d1: f64,
     d2: f64,
@@ -67,7 +69,13 @@ fn table() -> &'static Table {
         let d1 = truncate_25_bits(d);
         let d2 = truncate_25_bits(d - d1);
         let d3 = (d - d1 - d2) + TAU_LO / STEPS as f64;
-        Table { values, d1, d2, d3 }
+        Table {
+            sines: values.map(|v| v.0),
+            cosines: values.map(|v| v.1),
+            d1,
+            d2,
+            d3,
+        }
     })
 }
 
@@ -85,7 +93,8 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let k_int = (y + 0.5f64.copysign(y)) as i64;
     let k = k_int as f64;
     let r = ((x - k * t.d1) - k * t.d2) - k * t.d3;
-    let (s_j, c_j) = t.values[(k_int & (STEPS as i64 - 1)) as usize];
+    let j = (k_int & (STEPS as i64 - 1)) as usize;
+    let (s_j, c_j) = (t.sines[j], t.cosines[j]);
     let r2 = r * r;
     let sin_r = r + r * r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0)));
     let cos_r_minus_1 =
@@ -121,7 +130,8 @@ pub fn sin_cos_lanes<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
     }
     let (mut s_j, mut c_j) = ([0.0; N], [0.0; N]);
     for i in 0..N {
-        (s_j[i], c_j[i]) = t.values[(k_int[i] & (STEPS as i32 - 1)) as usize];
+        let j = (k_int[i] & (STEPS as i32 - 1)) as usize;
+        (s_j[i], c_j[i]) = (t.sines[j], t.cosines[j]);
     }
     let mut out = ([0.0; N], [0.0; N]);
     for i in 0..N {
@@ -138,7 +148,9 @@ pub fn sin_cos_lanes<const N: usize>(x: [f64; N]) -> ([f64; N], [f64; N]) {
 
 /// `(sin x, cos x)` of each lane of `x` (one run per lane in a campaign's lanes):
 /// [`sin_cos`]'s operations on each lane, bit for bit. The reduction's rounding to the table's
-/// node and the table's loads go lane by lane; the rest runs in the lanes. A lane out of the
+/// node ([`Lane::nearest_integer`]) and the table's loads ([`Lane::lookup_256`]) go lane by
+/// lane, or as vector conversions and gathers in the eight AVX-512 lanes; the rest runs in
+/// the lanes. A lane out of the
 /// reduction's range (or not a number) sends every lane to [`sin_cos`].
 #[inline(always)]
 pub fn sin_cos_in_lanes<L: Lane>(x: L) -> (L, L) {
@@ -154,15 +166,8 @@ pub fn sin_cos_in_lanes<L: Lane>(x: L) -> (L, L) {
         return (s, c);
     }
     let t = table();
-    let (mut k, mut s_j, mut c_j) = (x, x, x);
-    for i in 0..L::WIDTH {
-        let yi = y.lane(i);
-        let k_int = (yi + 0.5f64.copysign(yi)) as i64;
-        k = k.with_lane(i, k_int as f64);
-        let (s, c) = t.values[(k_int & (STEPS as i64 - 1)) as usize];
-        s_j = s_j.with_lane(i, s);
-        c_j = c_j.with_lane(i, c);
-    }
+    let k = y.nearest_integer();
+    let [s_j, c_j] = k.lookup_256([&t.sines, &t.cosines]);
     let c = L::splat;
     let r = ((x - k * c(t.d1)) - k * c(t.d2)) - k * c(t.d3);
     let r2 = r * r;
@@ -238,6 +243,42 @@ mod tests {
             let (s, c) = sin_cos_lanes(x);
             for i in 0..8 {
                 assert_eq!(bits((s[i], c[i])), bits(sin_cos(x[i])), "{}", x[i]);
+            }
+            if batch % 50 == 7 {
+                // Signed zeros, arguments next to a node's half-way point (the rounding's
+                // ties), small negatives (whose node is −0 before the +0 is added) and large
+                // ones.
+                let d = TAU / STEPS as f64;
+                let k = (batch / 50) as f64;
+                x = [
+                    -0.0,
+                    0.0,
+                    (k + 0.5) * d,
+                    -(k + 0.5) * d,
+                    -1e-300,
+                    -0.4 * d,
+                    3.0e6 - k,
+                    -(2.5e6 + 0.5 * d),
+                ];
+            }
+            #[cfg(target_arch = "x86_64")]
+            if crate::cpu::avx512_available() {
+                /// Eight at a time in the AVX-512 lanes (vector rounding and gathers).
+                #[target_feature(enable = "avx512f")]
+                fn eight(x: [f64; 8]) -> [(f64, f64); 8] {
+                    use crate::lanes::f64x8::F64x8;
+                    let lanes = x
+                        .iter()
+                        .enumerate()
+                        .fold(F64x8::splat(0.0), |l, (i, v)| l.with_lane(i, *v));
+                    let (s, c) = sin_cos_in_lanes(lanes);
+                    std::array::from_fn(|i| (s.lane(i), c.lane(i)))
+                }
+                // SAFETY: the processor has AVX-512F.
+                let got = unsafe { eight(x) };
+                for (g, v) in got.iter().zip(x) {
+                    assert_eq!(bits(*g), bits(sin_cos(v)), "eight lanes: {v}");
+                }
             }
             // The same arguments four at a time in the campaigns' lanes, and one at a time.
             for half in x.chunks(4) {

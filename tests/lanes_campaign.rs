@@ -234,3 +234,54 @@ fn a_scene_without_a_lane_form_says_why() {
     .unwrap();
     assert!(matches!(&p.integration, Integration::Scalar(why) if why.contains("radau5")));
 }
+
+/// The hinged-rods class: explorer1-pydy's four flap–lag rods with its dispersions (rates,
+/// hinge damping, stiffness and rod mass, the hull's axial moment and axes) and runs of
+/// different lengths, a terminal event that stops some of them, with dop853 and dopri5.
+#[test]
+fn a_hinged_rods_campaign_gives_the_scalar_rows_in_lanes() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/explorer1-pydy.yaml");
+    let text = std::fs::read_to_string(&path).expect("the scenario");
+    for integrator in [
+        "{method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+        "{method: dopri5, rtol: 1.0e-8, atol: 1.0e-10}",
+    ] {
+        let mut yaml = text.clone();
+        for (from, to) in [
+            (
+                "integrator: {method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+                format!(
+                    "integrator: {integrator}\nstop: [{{nutation_angle_deg: {{above: 80.0}}}}]"
+                ),
+            ),
+            ("runs: 100", "runs: 12".into()),
+            ("duration: 150.0", "duration: 70.0".into()),
+            (
+                "output: {rate: 200, scene_rate: 50}",
+                "output: {rate: 20}".into(),
+            ),
+            (
+                "probability_by: [60, 100, 150]",
+                "probability_by: [30, 60]".into(),
+            ),
+            (
+                "    - {inertia: {sd: 0.0, axes_sd_deg: 0.2}}\n",
+                "    - {inertia: {sd: 0.0, axes_sd_deg: 0.2}}\n    \
+                 - {path: duration, uniform: {min: 5.0, max: 70.0}}\n"
+                    .into(),
+            ),
+        ] {
+            assert!(yaml.contains(from), "the scenario has `{from}`");
+            yaml = yaml.replace(from, &to);
+        }
+        let sc = scenario::parse(Path::new("pydy.yaml"), yaml, &Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let p = Prepared::new(sc, "pydy.yaml", None, None).unwrap_or_else(|e| panic!("{e}"));
+        let rows = assert_same_rows(p);
+        let stopped = rows.iter().filter(|r| r.message.contains("above")).count();
+        assert!(
+            stopped > 0 && stopped < 12,
+            "{integrator}: {stopped} of 12 runs stopped: the case should mix both"
+        );
+    }
+}

@@ -92,6 +92,25 @@ pub struct RodMomentum<L> {
     pub kinetic_energy: L,
 }
 
+/// One row of W for the freedom whose ∂ê/∂θ is `j`, whose inertia is `mass_k` (kg m²) and
+/// generalised force `q_k` (N m): [(Q − j·F_s) / M_kk, m₁ j / M_kk, (p₂ × j) / M_kk], with
+/// p₂ = m₁ h + m₂ ê and F_s the rod's inertial force per unit of m₂ (written out, without
+/// loops or closures, for the AVX-512 lanes).
+#[inline(always)]
+fn row<L: Lane>(j: [L; 3], mass_k: L, q_k: L, m1: L, p2: [L; 3], force_s: [L; 3]) -> [L; 7] {
+    let inv = L::splat(1.0) / mass_k;
+    let torque = cross(p2, j);
+    [
+        (q_k - dot(j, force_s)) * inv,
+        m1 * j[0] * inv,
+        m1 * j[1] * inv,
+        m1 * j[2] * inv,
+        torque[0] * inv,
+        torque[1] * inv,
+        torque[2] * inv,
+    ]
+}
+
 impl<L: Lane> RodConstants<L> {
     /// ê and its derivatives from `[sin θ_f, cos θ_f, sin θ_l, cos θ_l]`, as
     /// `HingedRod::direction_at`.
@@ -154,19 +173,12 @@ impl<L: Lane> RodConstants<L> {
             sub(scale(dot(omega, p2), omega), scale(w2, p2)),
             scale(m2, relative),
         );
-        let mut rows = [L::splat(0.0); ROWS];
-        for (k, (j, mass_k, q_k)) in [(e_f, m2, q_flap), (e_l, m2 * cos2, q_lag)]
-            .into_iter()
-            .enumerate()
-        {
-            let inv = L::splat(1.0) / mass_k;
-            let torque = cross(p2, j);
-            rows[7 * k] = (q_k - dot(j, force_s)) * inv;
-            for a in 0..3 {
-                rows[7 * k + 1 + a] = m1 * j[a] * inv;
-                rows[7 * k + 4 + a] = torque[a] * inv;
-            }
-        }
+        let flap = row(e_f, m2, q_flap, m1, p2, force_s);
+        let lag = row(e_l, m2 * cos2, q_lag, m1, p2, force_s);
+        let rows = [
+            flap[0], flap[1], flap[2], flap[3], flap[4], flap[5], flap[6], lag[0], lag[1], lag[2],
+            lag[3], lag[4], lag[5], lag[6],
+        ];
         RodCoupling {
             hinge_force,
             hinge_moment,

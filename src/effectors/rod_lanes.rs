@@ -142,7 +142,7 @@ impl RodLanes {
 
     /// Lane `r`'s rod as the closed form takes it.
     #[inline(always)]
-    fn constants(&self, r: usize) -> RodConstants<f64> {
+    pub(crate) fn constants(&self, r: usize) -> RodConstants<f64> {
         let at = |v: &LaneVectors| [v[0][r], v[1][r], v[2][r]];
         RodConstants {
             hinge: at(&self.hinge),
@@ -166,6 +166,11 @@ impl RodLanes {
             [angles[0][r], angles[1][r], angles[2][r], angles[3][r]],
             [s[r], c[r], s[LANES + r], c[LANES + r]],
         )
+    }
+
+    /// The rods' constant part of the hub's mass matrix (lower triangle).
+    pub(crate) fn constant_mass(&self) -> &Matrix6<f64> {
+        &self.constant_mass
     }
 
     /// The groups of a spacecraft's flap–lag rods, [`LANES`] at a time in the order the

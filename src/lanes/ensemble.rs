@@ -14,8 +14,9 @@
 //! [`LaneSystem`] writes with the scalar path's operations), so each lane's steps, rejections,
 //! right-hand-side count and final state are bit for bit those of the scalar method on that
 //! run's `Spacecraft`, stepped to the same end time. The engine knows no class: a class joins
-//! the lanes by implementing the two traits ([`super::damper`], the nutation-damper class, and
-//! [`super::energy_sink`], a rigid body with an energy sink).
+//! the lanes by implementing the two traits ([`super::damper`], the nutation-damper class,
+//! [`super::energy_sink`], a rigid body with an energy sink, and [`super::hinged_rods`], a hub
+//! with four flap–lag rods).
 //!
 //! [`integrate_runs`] picks the engine at run time: eight f64 lanes compiled for AVX-512
 //! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
@@ -414,8 +415,21 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> StepInLa
     }
     fn prepare_interpolation(&mut self) -> bool {
         let i = self.lane;
-        self.lanes
-            .prepare_dense(L::Mask::splat(false).with_lane(i, true));
+        let needed = L::Mask::splat(false).with_lane(i, true);
+        // Called by the monitor, outside the engine: compiled for the engine's instruction set
+        // again, or the eight lanes' operations would be calls (the stages are a system's
+        // right-hand side three times).
+        #[cfg(target_arch = "x86_64")]
+        if L::WIDTH == 8 {
+            // SAFETY: eight lanes are made only where the processor has AVX-512F (`f64x8`).
+            unsafe { prepare_dense_avx512(self.lanes, needed) };
+            return self.lanes.dense_finite.test(i);
+        } else if L::WIDTH == 4 && crate::cpu::avx2_available() {
+            // SAFETY: the processor has AVX2.
+            unsafe { prepare_dense_avx2(self.lanes, needed) };
+            return self.lanes.dense_finite.test(i);
+        }
+        self.lanes.prepare_dense(needed);
         self.lanes.dense_finite.test(i)
     }
     fn interpolant(&self) -> LaneInterpolant<DIM> {
@@ -429,6 +443,31 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> StepInLa
             .method
             .interpolant(i, read(&lanes.h_step, i), &y_start, &y_new)
     }
+}
+
+/// [`Lanes::prepare_dense`] compiled for AVX-512F (the eight lanes' intrinsics inline).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn prepare_dense_avx512<
+    L: Lane,
+    R: LaneRun<DIM>,
+    M: LaneMethod<L, DIM>,
+    const DIM: usize,
+>(
+    lanes: &mut Lanes<L, R, M, DIM>,
+    needed: L::Mask,
+) {
+    lanes.prepare_dense(needed)
+}
+
+/// [`Lanes::prepare_dense`] compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn prepare_dense_avx2<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize>(
+    lanes: &mut Lanes<L, R, M, DIM>,
+    needed: L::Mask,
+) {
+    lanes.prepare_dense(needed)
 }
 
 /// A run's state where it stands, with no step in the lanes: at its start, or at its end

@@ -21,11 +21,13 @@
 use super::{Lane, LaneMask};
 use std::arch::x86_64::{
     __m512d, __mmask8, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
-    _MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC, _mm512_add_pd, _mm512_and_epi64, _mm512_castpd_si512,
-    _mm512_castsi512_pd, _mm512_cmp_pd_mask, _mm512_cvtsd_f64, _mm512_div_pd, _mm512_getexp_pd,
-    _mm512_getmant_pd, _mm512_loadu_pd, _mm512_mask_blend_pd, _mm512_mask_mov_pd, _mm512_mul_pd,
-    _mm512_permutexvar_pd, _mm512_scalef_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd,
-    _mm512_storeu_pd, _mm512_sub_pd, _mm512_xor_epi64,
+    _MM_FROUND_NO_EXC, _MM_FROUND_TO_ZERO, _MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC, _mm256_and_si256,
+    _mm256_set1_epi32, _mm512_add_pd, _mm512_and_epi64, _mm512_castpd_si512, _mm512_castsi512_pd,
+    _mm512_cmp_pd_mask, _mm512_cvtsd_f64, _mm512_cvttpd_epi32, _mm512_div_pd, _mm512_getexp_pd,
+    _mm512_getmant_pd, _mm512_i32gather_pd, _mm512_loadu_pd, _mm512_mask_blend_pd,
+    _mm512_mask_mov_pd, _mm512_mul_pd, _mm512_permutexvar_pd, _mm512_roundscale_pd,
+    _mm512_scalef_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd, _mm512_storeu_pd,
+    _mm512_sub_pd, _mm512_xor_epi64,
 };
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
@@ -230,6 +232,29 @@ impl Lane for F64x8 {
         assert!(i < 8);
         // SAFETY: AVX-512F: see the module.
         F64x8(unsafe { _mm512_mask_mov_pd(self.0, 1 << i, _mm512_set1_pd(x)) })
+    }
+    /// `x + copysign(½, x)` (the sign bit of x on ½), truncated by `vrndscalepd`, plus +0
+    /// (which turns a −0 into +0, as `as i64 as f64` gives, and leaves the rest).
+    #[inline(always)]
+    fn nearest_integer(self) -> Self {
+        // SAFETY: AVX-512F: see the module.
+        unsafe {
+            let sign = _mm512_and_epi64(_mm512_castpd_si512(self.0), _mm512_set1_epi64(i64::MIN));
+            let half = _mm512_xor_epi64(_mm512_castpd_si512(_mm512_set1_pd(0.5)), sign);
+            let t = _mm512_add_pd(self.0, _mm512_castsi512_pd(half));
+            let k = _mm512_roundscale_pd::<{ _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC }>(t);
+            F64x8(_mm512_add_pd(k, _mm512_set1_pd(0.0)))
+        }
+    }
+    /// Two gathers by the lanes' integers, converted (exact below 2³¹) and reduced mod 256.
+    #[inline(always)]
+    fn lookup_256(self, tables: [&[f64; 256]; 2]) -> [Self; 2] {
+        // SAFETY: AVX-512F (which implies AVX2): see the module. Every index is in 0..256, so
+        // every gathered address is inside its table.
+        unsafe {
+            let index = _mm256_and_si256(_mm512_cvttpd_epi32(self.0), _mm256_set1_epi32(255));
+            tables.map(|table| F64x8(_mm512_i32gather_pd::<8>(index, table.as_ptr() as _)))
+        }
     }
     #[inline(always)]
     fn gather_lane(values: &[Self], i: usize, out: &mut [f64]) {

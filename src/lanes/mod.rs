@@ -22,7 +22,8 @@
 //! lanes and at f64 alike), [`ensemble`] (the lockstep ensemble, with the AVX2 and
 //! AVX-512 dispatch, generic over the class of runs it integrates: [`ensemble::LaneRun`] and
 //! [`ensemble::LaneSystem`]), `methods` (dopri5 and dop853 in lanes), [`damper`] (the
-//! nutation-damper class), [`energy_sink`] (a rigid body with an energy sink). docs/montecarlo.md,
+//! nutation-damper class), [`energy_sink`] (a rigid body with an energy sink), [`hinged_rods`]
+//! (a hub with four flap–lag hinged rods). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;
@@ -32,6 +33,7 @@ pub mod ensemble;
 pub mod f64x4;
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod f64x8;
+pub mod hinged_rods;
 pub mod linalg;
 pub(crate) mod methods;
 #[cfg(test)]
@@ -87,6 +89,31 @@ pub trait Lane:
         for (o, v) in out.iter_mut().zip(values) {
             *o = v.lane(i);
         }
+    }
+    /// The nearest integer to each lane, halves away from zero, as [`crate::sincos::sin_cos`]
+    /// rounds: `(x + copysign(½, x))` truncated toward zero, as f64, with zero as +0. For
+    /// |x| < 2³¹; lane by lane through `as i64` by default.
+    #[inline(always)]
+    fn nearest_integer(self) -> Self {
+        let mut out = self;
+        for i in 0..Self::WIDTH {
+            let x = self.lane(i);
+            out = out.with_lane(i, (x + 0.5f64.copysign(x)) as i64 as f64);
+        }
+        out
+    }
+    /// For lanes that hold integers k (as f64, |k| < 2³¹): `table[k mod 256]` of each of the
+    /// two tables, lane by lane (two's complement residue: k = −1 reads entry 255). Lane by
+    /// lane through [`Lane::lane`] by default; the eight AVX-512 lanes gather.
+    #[inline(always)]
+    fn lookup_256(self, tables: [&[f64; 256]; 2]) -> [Self; 2] {
+        let mut out = [self; 2];
+        for i in 0..Self::WIDTH {
+            let j = (self.lane(i) as i64 & 255) as usize;
+            out[0] = out[0].with_lane(i, tables[0][j]);
+            out[1] = out[1].with_lane(i, tables[1][j]);
+        }
+        out
     }
     /// |x| per lane.
     fn abs(self) -> Self;

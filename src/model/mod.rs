@@ -763,8 +763,7 @@ impl Spacecraft {
         self.lone_only = self.only_the_lone_mover();
     }
 
-    /// The members of each of its effector groups ([`Effector::grouping`]), for tests.
-    #[cfg(test)]
+    /// The members of each of its effector groups ([`Effector::grouping`]).
     pub(crate) fn group_members(&self) -> Vec<Vec<usize>> {
         self.groups.iter().map(|g| g.members().to_vec()).collect()
     }
@@ -792,6 +791,21 @@ impl Spacecraft {
             && self.effectors.len() <= MAX_FAST_TORQUES
             && !self.expels_mass
             && self.euler_coefficients.is_some()
+    }
+
+    /// Whether the right-hand side is the hub's 6 × 6 equations with every effector coupled
+    /// through its group (`RodLanes`, say) and none alone: the hub's mass is set, no effector
+    /// is torque-only or alone in its closed form, and nothing is prescribed, expelled or
+    /// acted on by a field.
+    pub fn takes_grouped_closed_form(&self) -> bool {
+        self.motion.is_none()
+            && !self.lone_only
+            && !self.torque_only
+            && self.translation
+            && self.tidal_source.is_none()
+            && !self.expels_mass
+            && !self.effectors.is_empty()
+            && self.grouped.iter().all(|&g| g)
     }
 
     /// The prescribed hub motion, if any.

@@ -3,12 +3,14 @@
 //! the same dense output, so a run's outcome is the scalar path's (docs/montecarlo.md, "Lanes
 //! in a campaign").
 //!
-//! Two classes have a lane form ([`LaneForm`]), each integrated by dopri5 or dop853: the
-//! nutation-damper class ([`crate::lanes::damper`], a rigid hub with one spring–mass damper)
-//! and the energy-sink class ([`crate::lanes::energy_sink`], a rigid hub with principal axes
-//! and one energy sink). [`lane_form`] says why another scene has none; such a run, or one
+//! Three classes have a lane form ([`LaneForm`]), each integrated by dopri5 or dop853: the
+//! nutation-damper class ([`crate::lanes::damper`], a rigid hub with one spring–mass damper),
+//! the energy-sink class ([`crate::lanes::energy_sink`], a rigid hub with principal axes and
+//! one energy sink) and the hinged-rods class ([`crate::lanes::hinged_rods`], a hub with four
+//! flap–lag rods). [`lane_form`] says why another scene has none; such a run, or one
 //! the lanes decline part-way, takes the scalar path.
 
+use super::method::Adaptive;
 use super::monitor::{Monitor, StepView};
 use super::{
     Drift, Method, Outcome, Quantity, Simulation, Sink, Status, diagnose, interior_checks,
@@ -23,6 +25,7 @@ use crate::lanes::ensemble::{
     Engine, GridObservation, LaneInterpolant, LaneMethodKind, LaneObservation, LaneRun,
     LaneSettings, LaneStatus, LaneStep, StepInLanes, integrate_runs_observed_with,
 };
+use crate::lanes::hinged_rods::{self, RodsRun};
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
@@ -184,6 +187,8 @@ pub enum LaneForm {
     Damper(DamperRun),
     /// A rigid hub with principal axes and one energy sink ([`crate::lanes::energy_sink`]).
     EnergySink(SinkRun),
+    /// A hub with four flap–lag hinged rods ([`crate::lanes::hinged_rods`]).
+    HingedRods(Box<RodsRun>),
 }
 
 /// `sim` as a run of a class of the lanes and the integration settings it needs, or why it is
@@ -203,13 +208,21 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
     if let Some(refusal) = sim.method.refusal(sc, sim.duration) {
         return Err(format!("{} refuses it ({refusal})", sim.method.name()));
     }
+    if sc.effectors().len() == hinged_rods::RODS {
+        if sc.next_breakpoint(0.0).is_some() {
+            return Err("it has breakpoints, at which the lanes do not stop".into());
+        }
+        let form = LaneForm::HingedRods(Box::new(rods_run(sim)?));
+        return Ok((form, settings(method, a)));
+    }
     let one = match sc.effectors() {
         [one] => one,
         list => {
             return Err(format!(
-                "it has {} effectors, and the lanes have a hub with one spring_mass_damper or \
-                 one energy_sink only",
-                list.len()
+                "it has {} effectors, and the lanes have a hub with one spring_mass_damper, \
+                 one energy_sink or {} flap–lag hinged_rods only",
+                list.len(),
+                hinged_rods::RODS
             ));
         }
     };
@@ -223,21 +236,25 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
         LaneForm::EnergySink(sink_run(sim, sink)?)
     } else {
         return Err(format!(
-            "its effector `{}` ({}) has no lane form (the lanes have the spring_mass_damper \
-             and the energy_sink)",
+            "its effector `{}` ({}) has no lane form (the lanes have the spring_mass_damper, \
+             the energy_sink and four flap–lag hinged_rods together)",
             one.name(),
             one.kind()
         ));
     };
-    let settings = LaneSettings {
+    Ok((form, settings(method, a)))
+}
+
+/// The lanes' settings for `method` with the scalar method's settings `a`.
+fn settings(method: LaneMethodKind, a: Adaptive) -> LaneSettings {
+    LaneSettings {
         method,
         tolerances: Tolerances {
             rtol: a.rtol,
             atol: a.atol,
         },
         h_max: a.max_step,
-    };
-    Ok((form, settings))
+    }
 }
 
 /// Whether `run` starts where the scalar path starts `sim`, bit for bit (the lanes' layout is
@@ -311,6 +328,12 @@ fn sink_run(sim: &Simulation, sink: &EnergySink) -> Result<SinkRun, String> {
     Ok(run)
 }
 
+/// `sim` as a run of the hinged-rods class.
+fn rods_run(sim: &Simulation) -> Result<RodsRun, String> {
+    let y0 = sim.spacecraft.initial_state(&sim.omega0, &sim.attitude0);
+    RodsRun::new(&sim.spacecraft, &y0, sim.duration, sim.output_rate)
+}
+
 /// One run in the lanes: its monitor, its sink, and the status its monitor ended it with.
 struct Watched<'a, S> {
     index: usize,
@@ -348,6 +371,16 @@ pub fn run_in_lanes<S: Sink + Default>(
             forms,
             |f| match f {
                 LaneForm::EnergySink(run) => Some(run),
+                _ => None,
+            },
+            interrupt,
+        ),
+        Some((LaneForm::HingedRods(_), _)) => run_class::<S, RodsRun, { hinged_rods::DIM }>(
+            engine,
+            sims,
+            forms,
+            |f| match f {
+                LaneForm::HingedRods(run) => Some(*run),
                 _ => None,
             },
             interrupt,
