@@ -19,7 +19,7 @@ mod support;
 
 pub use checks::{DriftLimits, OnBreach};
 pub use condition::{Condition, Quantity};
-pub use lanes::{lane_form, run_in_lanes};
+pub use lanes::{LaneForm, lane_form, run_in_lanes};
 pub use memory::Memory;
 pub use method::{Adaptive, Method};
 pub use relay::{Record, Relay, Relayed, receive_run};
