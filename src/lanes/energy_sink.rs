@@ -241,29 +241,7 @@ mod tests {
                 "rhs, lane {i}"
             );
             let s = sc.observe(0.0, &states[i]);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            let lane = |v: F64x4| v.lane(i);
-            assert_eq!(
-                bits(&o.h_body.map(lane)),
-                bits(s.h_body.as_slice()),
-                "H, lane {i}"
-            );
-            assert_eq!(bits(&o.h_inertial.map(lane)), bits(s.h_inertial.as_slice()));
-            let scalars = [
-                (o.kinetic_energy, s.kinetic_energy),
-                (o.elastic_energy, s.elastic_energy),
-                (o.dissipated_energy, s.dissipated_energy),
-                (o.dissipation_power, s.dissipation_power),
-                (o.q_norm_error, s.q_norm_error),
-                (o.h_norm, s.h_norm),
-                (o.nutation_angle, s.nutation_angle),
-            ];
-            for (k, (a, b)) in scalars.into_iter().enumerate() {
-                assert_eq!(a.lane(i).to_bits(), b.to_bits(), "quantity {k}, lane {i}");
-            }
-            let q = s.attitude.quaternion();
-            let attitude = o.attitude.map(lane);
-            assert_eq!(bits(&attitude), bits(&[q.w, q.i, q.j, q.k]), "lane {i}");
+            crate::lanes::ensemble::assert_lane_is_observation(&o, i, &s);
         }
     }
 }

@@ -198,6 +198,43 @@ pub struct LaneObservation<T = f64> {
     pub nutation_angle: T,
 }
 
+/// Asserts that lane `i` of the lanes' observation `o` is the scalar observation `s`, bit for
+/// bit: H in both frames, the energies, |q| − 1, |H|, the nutation angle and the attitude.
+#[cfg(test)]
+pub(crate) fn assert_lane_is_observation(
+    o: &LaneObservation<super::F64x4>,
+    i: usize,
+    s: &crate::model::Observation,
+) {
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let lane = |v: super::F64x4| v.lane(i);
+    assert_eq!(
+        bits(&o.h_body.map(lane)),
+        bits(s.h_body.as_slice()),
+        "H, lane {i}"
+    );
+    assert_eq!(bits(&o.h_inertial.map(lane)), bits(s.h_inertial.as_slice()));
+    let scalars = [
+        (o.kinetic_energy, s.kinetic_energy),
+        (o.elastic_energy, s.elastic_energy),
+        (o.dissipated_energy, s.dissipated_energy),
+        (o.dissipation_power, s.dissipation_power),
+        (o.q_norm_error, s.q_norm_error),
+        (o.h_norm, s.h_norm),
+        (o.nutation_angle, s.nutation_angle),
+    ];
+    for (k, (a, b)) in scalars.into_iter().enumerate() {
+        assert_eq!(a.lane(i).to_bits(), b.to_bits(), "quantity {k}, lane {i}");
+    }
+    let q = s.attitude.quaternion();
+    let attitude = o.attitude.map(lane);
+    assert_eq!(
+        bits(&attitude),
+        bits(&[q.w, q.i, q.j, q.k]),
+        "attitude, lane {i}"
+    );
+}
+
 impl<L: Lane> LaneObservation<L> {
     /// The observation of a hub whose integrated quaternion is `q` (w, x, y, z; not yet of
     /// unit norm) and whose system has angular momentum `h` (body axes, N m s), with the
