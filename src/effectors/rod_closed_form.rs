@@ -70,7 +70,7 @@ pub struct RodCoupling<L> {
     pub hinge_moment: [L; 3],
     /// v = [ê; h × ê]: the reduced mass μ adds μ v vᵀ to the hub's mass matrix.
     pub v: [L; 6],
-    /// The rows W: θ̈_k = W_k[0] − Σ_a W_k[1 + a] z_a, z the hub's acceleration [a_B; ω̇].
+    /// The rows W: θ̈_k = W_k(0) − Σ_a W_k(1 + a) z_a, z the hub's acceleration (a_B, ω̇).
     pub rows: [L; ROWS],
     /// |∂ê/∂θ_l|² = cos² θ_f: the lag's inertia over m₂ (zero at a flap of 90°).
     pub cos2: L,
