@@ -55,9 +55,6 @@ impl LaneRun<DIM> for SinkRun {
     fn sample_rate(&self) -> f64 {
         self.sample_rate
     }
-    fn admitted(&self) -> bool {
-        true
-    }
 }
 
 /// The parameters of the class's runs in the lanes, one run per lane. Matrices by columns

@@ -48,8 +48,10 @@ pub trait LaneRun<const DIM: usize>: Sized {
     /// ([`LaneStep::sample`]); 0 (or not finite): none.
     fn sample_rate(&self) -> f64;
     /// Whether the lanes take the run at all; one they do not take ends at t = 0 as
-    /// [`LaneStatus::Declined`].
-    fn admitted(&self) -> bool;
+    /// [`LaneStatus::Declined`]. Every run, unless the class says otherwise.
+    fn admitted(&self) -> bool {
+        true
+    }
 }
 
 /// The parameters of the runs of class `R` in the lanes, one run per lane, and what the
