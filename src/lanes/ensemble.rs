@@ -52,6 +52,12 @@ pub trait LaneRun<const DIM: usize>: Sized {
     fn admitted(&self) -> bool {
         true
     }
+    /// Whether the stages call the class's right-hand side out of line (one copy per lane
+    /// type, compiled for the engine's instruction set) rather than inlined into each stage:
+    /// for a right-hand side long enough that a call costs nothing beside it, and whose
+    /// fifteen-odd inlined copies per method and lane type would make the engines' code
+    /// megabytes long and the build minutes longer.
+    const RHS_OUT_OF_LINE: bool = false;
 }
 
 /// The parameters of the runs of class `R` in the lanes, one run per lane, and what the
@@ -676,7 +682,9 @@ fn run_method<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
     match resolved(engine) {
-        Engine::Portable4 => lockstep::<F64x4, R, F, DIM>(runs, settings, observe),
+        Engine::Portable4 => {
+            lockstep::<F64x4, R, F, DIM>(runs, settings, observe, rhs_baseline::<F64x4, R, DIM>)
+        }
         #[cfg(target_arch = "x86_64")]
         Engine::Avx2 => {
             // SAFETY: `resolved` chose AVX2 only where the processor has it.
@@ -687,7 +695,7 @@ fn run_method<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
             // SAFETY: `resolved` chose AVX-512F only where the processor has it.
             unsafe { lockstep_avx512::<R, F, DIM>(runs, settings, observe) }
         }
-        _ => lockstep::<f64, R, F, DIM>(runs, settings, observe),
+        _ => lockstep::<f64, R, F, DIM>(runs, settings, observe, rhs_baseline::<f64, R, DIM>),
     }
 }
 
@@ -701,7 +709,7 @@ unsafe fn lockstep_avx2<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
-    lockstep::<F64x4, R, F, DIM>(runs, settings, observe)
+    lockstep::<F64x4, R, F, DIM>(runs, settings, observe, rhs_avx2::<R, DIM>)
 }
 
 /// [`lockstep`] at eight lanes, compiled for AVX-512F so that the lane type's intrinsics
@@ -714,20 +722,79 @@ unsafe fn lockstep_avx512<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
-    lockstep::<super::f64x8::F64x8, R, F, DIM>(runs, settings, observe)
+    lockstep::<super::f64x8::F64x8, R, F, DIM>(runs, settings, observe, rhs_avx512::<R, DIM>)
+}
+
+/// A class's right-hand side ([`LaneSystem::rhs`]) in a function of its own, compiled for the
+/// engine's instruction set: what the stages call for a class with
+/// [`LaneRun::RHS_OUT_OF_LINE`]. Unsafe to call only in that an engine's copy may be made for
+/// an instruction set the processor must have; each engine makes its own.
+type CompiledRhs<L, R, const DIM: usize> =
+    unsafe fn(&<R as LaneRun<DIM>>::System<L>, &[L], &mut [L]) -> <L as Lane>::Mask;
+
+/// [`LaneSystem::rhs`] out of line, compiled for the baseline instruction set (the scalar
+/// engine and the portable four lanes).
+#[inline(never)]
+fn rhs_baseline<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
+    system: &R::System<L>,
+    y: &[L],
+    dy: &mut [L],
+) -> L::Mask {
+    system.rhs(y, dy)
+}
+
+/// [`LaneSystem::rhs`] out of line at four lanes, compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn rhs_avx2<R: LaneRun<DIM>, const DIM: usize>(
+    system: &R::System<F64x4>,
+    y: &[F64x4],
+    dy: &mut [F64x4],
+) -> <F64x4 as Lane>::Mask {
+    system.rhs(y, dy)
+}
+
+/// [`LaneSystem::rhs`] out of line at eight lanes, compiled for AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline(never)]
+unsafe fn rhs_avx512<R: LaneRun<DIM>, const DIM: usize>(
+    system: &R::System<super::f64x8::F64x8>,
+    y: &[super::f64x8::F64x8],
+    dy: &mut [super::f64x8::F64x8],
+) -> <super::f64x8::F64x8 as Lane>::Mask {
+    system.rhs(y, dy)
 }
 
 /// The system as the stages' right-hand side, noting the lanes whose closed form was solved
 /// at every stage.
 struct Solving<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> {
     system: &'a R::System<L>,
+    /// The engine's out-of-line copy of the right-hand side.
+    compiled: CompiledRhs<L, R, DIM>,
     solved: L::Mask,
+}
+
+impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Solving<'_, L, R, DIM> {
+    /// The right-hand side at `y` into `dydt`: inlined, or the engine's copy out of line
+    /// ([`LaneRun::RHS_OUT_OF_LINE`]); the lanes whose closed form was solved.
+    #[inline(always)]
+    fn call(&self, y: &[L], dydt: &mut [L]) -> L::Mask {
+        if R::RHS_OUT_OF_LINE {
+            // SAFETY: `compiled` is the copy the running engine made for its own instruction
+            // set, which the processor has (`run_method`).
+            unsafe { (self.compiled)(self.system, y, dydt) }
+        } else {
+            self.system.rhs(y, dydt)
+        }
+    }
 }
 
 impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> StageRhs<L> for Solving<'_, L, R, DIM> {
     #[inline(always)]
     fn eval(&mut self, _t: L, y: &[L], dydt: &mut [L]) {
-        self.solved = self.solved & self.system.rhs(y, dydt);
+        self.solved = self.solved & self.call(y, dydt);
     }
 }
 
@@ -743,6 +810,8 @@ struct SampleLanes<L: Lane, const DIM: usize> {
 /// The lanes' integration state: each field holds one value per lane.
 struct Lanes<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> {
     system: R::System<L>,
+    /// The running engine's out-of-line copy of the system's right-hand side.
+    compiled_rhs: CompiledRhs<L, R, DIM>,
     /// The method's stages.
     method: M,
     /// The shared settings, splat.
@@ -803,10 +872,11 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     /// Every lane empty, holding `run`'s values (finite, so that idle lanes compute harmless
     /// numbers).
     #[inline(always)]
-    fn new(run: &R, settings: &LaneSettings) -> Self {
+    fn new(run: &R, settings: &LaneSettings, compiled_rhs: CompiledRhs<L, R, DIM>) -> Self {
         let z = L::splat(0.0);
         let mut lanes = Lanes {
             system: R::System::<L>::idle(),
+            compiled_rhs,
             method: M::zeroed(),
             atol: L::splat(settings.tolerances.atol),
             rtol: L::splat(settings.tolerances.rtol),
@@ -988,9 +1058,13 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     #[inline(always)]
     fn start(&mut self, starting: L::Mask) {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let system = &self.system;
         let mut first = [zero; DIM];
-        let solved = system.rhs(&self.y, &mut first);
+        let solved = Solving::<L, R, DIM> {
+            system: &self.system,
+            compiled: self.compiled_rhs,
+            solved: L::Mask::splat(true),
+        }
+        .call(&self.y, &mut first);
         self.rhs_evaluations += L::select(starting, one, zero);
         let mut finite = L::Mask::splat(true);
         let k1 = self.method.first_stage();
@@ -1011,6 +1085,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         let starting = starting & self.running;
         let mut rhs = Solving::<L, R, DIM> {
             system: &self.system,
+            compiled: self.compiled_rhs,
             solved: L::Mask::splat(true),
         };
         let h = self.method.initial_step(
@@ -1116,6 +1191,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         }
         let mut rhs = Solving::<L, R, DIM> {
             system: &self.system,
+            compiled: self.compiled_rhs,
             solved: L::Mask::splat(true),
         };
         let finite = self.method.dense_stages(
@@ -1161,6 +1237,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         let h = end.h;
         let mut rhs = Solving::<L, R, DIM> {
             system: &self.system,
+            compiled: self.compiled_rhs,
             solved: L::Mask::splat(true),
         };
         let err = self.method.attempt(
@@ -1186,6 +1263,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         if M::END_STAGE && passed.any() {
             let mut rhs = Solving::<L, R, DIM> {
                 system: &self.system,
+                compiled: self.compiled_rhs,
                 solved: L::Mask::splat(true),
             };
             let finite = self.method.end_stage(&mut rhs, end.t_new, &self.y_new);
@@ -1270,12 +1348,13 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     runs: &[R],
     settings: &LaneSettings,
     observe: Observing<'_, DIM>,
+    compiled_rhs: CompiledRhs<L, R, DIM>,
 ) -> Vec<LaneOutcome<DIM>> {
     let mut outcomes: Vec<Option<LaneOutcome<DIM>>> = vec![None; runs.len()];
     let Some(first) = runs.first() else {
         return Vec::new();
     };
-    let mut lanes = Lanes::<L, R, F::In<L, DIM>, DIM>::new(first, settings);
+    let mut lanes = Lanes::<L, R, F::In<L, DIM>, DIM>::new(first, settings, compiled_rhs);
     let mut observe = observe.map(|(grid, observer)| {
         lanes.grid = grid;
         observer
