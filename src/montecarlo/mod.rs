@@ -143,21 +143,9 @@ pub enum Integration {
 impl Integration {
     /// How the runs of `scenario` are integrated on this processor, in lanes with `engine`
     /// (or the nearest it has) where the scene has a lane form.
-    /// The hinged-rods class goes to the lanes unasked only with eight AVX-512 lanes: with
-    /// four AVX2 lanes it is no faster than its scalar path, whose four rods already fill the
-    /// AVX2 registers (docs/benchmarks.md); an explicit `--lane-width` is obeyed.
     pub fn of(scenario: &Scenario, engine: Engine) -> Self {
         use crate::lanes::ensemble::resolved;
         match sim::lane_form(scenario) {
-            Ok((sim::LaneForm::HingedRods(_), _))
-                if engine == Engine::Auto && resolved(engine) != Engine::Avx512 =>
-            {
-                Integration::Scalar(
-                    "the hinged-rods class runs in lanes unasked only with eight AVX-512 \
-                     lanes, and this processor has fewer"
-                        .into(),
-                )
-            }
             Ok(_) => Integration::Lanes(resolved(engine)),
             Err(why) => Integration::Scalar(format!("the scene has no lane form: {why}")),
         }
