@@ -146,6 +146,53 @@ fn gather<L: Lane, const DIM: usize, const S: usize>(
     out
 }
 
+/// A method's `S` stages in lanes (`k[0]` the step's first, f at its start), and the first
+/// stage of the last attempt, kept for its dense output once `k[0]` holds the next step's.
+pub(crate) struct Stages<L: Lane, const DIM: usize, const S: usize> {
+    k: [[L; DIM]; S],
+    k_start: [L; DIM],
+}
+
+impl<L: Lane, const DIM: usize, const S: usize> Stages<L, DIM, S> {
+    /// Every stage zero.
+    #[inline(always)]
+    fn zeroed() -> Self {
+        let z = L::splat(0.0);
+        Stages {
+            k: [[z; DIM]; S],
+            k_start: [z; DIM],
+        }
+    }
+
+    /// The last attempt's stages as its dense output reads them: its first stage, then the
+    /// others as they stand.
+    #[inline(always)]
+    fn step_stages(&self) -> [&[L; DIM]; S] {
+        std::array::from_fn(|j| if j == 0 { &self.k_start } else { &self.k[j] })
+    }
+
+    /// After an attempt: the lanes of `accept` take the new state `y_new` into `y` and, first
+    /// same as last, the next step's first stage from stage `last` (f at the new point); with
+    /// `observed`, the attempt's first stage is kept for its dense output.
+    #[inline(always)]
+    fn accept(
+        &mut self,
+        accept: L::Mask,
+        observed: bool,
+        y: &mut [L; DIM],
+        y_new: &[L; DIM],
+        last: usize,
+    ) {
+        if observed {
+            self.k_start = self.k[0];
+        }
+        for j in 0..DIM {
+            y[j] = L::select(accept, y_new[j], y[j]);
+            self.k[0][j] = L::select(accept, self.k[last][j], self.k[0][j]);
+        }
+    }
+}
+
 /// dopri5 in lanes.
 pub(crate) enum Dopri5 {}
 
@@ -153,21 +200,8 @@ impl MethodFamily for Dopri5 {
     type In<L: Lane, const DIM: usize> = Dopri5Lanes<L, DIM>;
 }
 
-/// dopri5's seven stages in lanes, and the first stage of the last attempt (for its dense
-/// output once `k[0]` holds the next step's).
-pub(crate) struct Dopri5Lanes<L: Lane, const DIM: usize> {
-    k: [[L; DIM]; 7],
-    k_start: [L; DIM],
-}
-
-impl<L: Lane, const DIM: usize> Dopri5Lanes<L, DIM> {
-    /// The last attempt's stages as its dense output reads them.
-    #[inline(always)]
-    fn step_stages(&self) -> [&[L; DIM]; 7] {
-        let [_, k2, k3, k4, k5, k6, k7] = &self.k;
-        [&self.k_start, k2, k3, k4, k5, k6, k7]
-    }
-}
+/// dopri5's seven stages in lanes.
+pub(crate) struct Dopri5Lanes<L: Lane, const DIM: usize>(Stages<L, DIM, 7>);
 
 impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
     const CONTROL: StepControl = dopri5::CONTROL;
@@ -177,16 +211,12 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
 
     #[inline(always)]
     fn zeroed() -> Self {
-        let z = L::splat(0.0);
-        Dopri5Lanes {
-            k: [[z; DIM]; 7],
-            k_start: [z; DIM],
-        }
+        Dopri5Lanes(Stages::zeroed())
     }
 
     #[inline(always)]
     fn first_stage(&mut self) -> &mut [L; DIM] {
-        &mut self.k[0]
+        &mut self.0.k[0]
     }
 
     #[inline(always)]
@@ -200,7 +230,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
         h_max: L,
         span: L,
     ) -> L {
-        let [k1, k2, ..] = &mut self.k;
+        let [k1, k2, ..] = &mut self.0.k;
         dopri5::initial_step(rhs, t, y, k1, k2, stage, atol, rtol, h_max, span)
     }
 
@@ -215,8 +245,8 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
         stage: &mut [L; DIM],
         (atol, rtol): (L, L),
     ) -> L {
-        dopri5::stages(rhs, t, h, y, &mut self.k, stage, y_new);
-        dopri5::error_norm(h, &self.k, y, y_new, atol, rtol)
+        dopri5::stages(rhs, t, h, y, &mut self.0.k, stage, y_new);
+        dopri5::error_norm(h, &self.0.k, y, y_new, atol, rtol)
     }
 
     #[inline(always)]
@@ -231,14 +261,8 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
 
     #[inline(always)]
     fn accept(&mut self, accept: L::Mask, observed: bool, y: &mut [L; DIM], y_new: &[L; DIM]) {
-        if observed {
-            self.k_start = self.k[0];
-        }
-        for j in 0..DIM {
-            y[j] = L::select(accept, y_new[j], y[j]);
-            // First same as last: the last stage is f at the new point.
-            self.k[0][j] = L::select(accept, self.k[6][j], self.k[0][j]);
-        }
+        // The seventh stage is f at the new point.
+        self.0.accept(accept, observed, y, y_new, 6);
     }
 
     #[inline(always)]
@@ -259,7 +283,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
     fn dense(&self, h: L, y: &[L; DIM], y_new: &[L; DIM]) -> Self::Dense {
         // What the caller does not read of the coefficients is dropped by the compiler.
         let mut cont = [[L::splat(0.0); DIM]; 5];
-        dopri5::dense_coefficients(h, &self.step_stages(), y, y_new, &mut cont);
+        dopri5::dense_coefficients(h, &self.0.step_stages(), y, y_new, &mut cont);
         cont
     }
 
@@ -275,7 +299,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dopri5Lanes<L, DIM> {
         y: &[f64; DIM],
         y_new: &[f64; DIM],
     ) -> LaneInterpolant<DIM> {
-        let k = gather(self.step_stages(), i);
+        let k = gather(self.0.step_stages(), i);
         let mut cont = [[0.0; DIM]; 5];
         dopri5::dense_coefficients(h, &k, y, y_new, &mut cont);
         LaneInterpolant::Dopri5(cont)
@@ -289,38 +313,9 @@ impl MethodFamily for Dop853 {
     type In<L: Lane, const DIM: usize> = Dop853Lanes<L, DIM>;
 }
 
-/// dop853's sixteen stages in lanes (1–12 of the step, 13 at its end, 14–16 of its dense
-/// output), and the first stage of the last attempt (once `k[0]` holds the next step's).
-pub(crate) struct Dop853Lanes<L: Lane, const DIM: usize> {
-    k: [[L; DIM]; 16],
-    k_start: [L; DIM],
-}
-
-impl<L: Lane, const DIM: usize> Dop853Lanes<L, DIM> {
-    /// The last attempt's stages as its dense output reads them.
-    #[inline(always)]
-    fn step_stages(&self) -> [&[L; DIM]; 16] {
-        let k = &self.k;
-        [
-            &self.k_start,
-            &k[1],
-            &k[2],
-            &k[3],
-            &k[4],
-            &k[5],
-            &k[6],
-            &k[7],
-            &k[8],
-            &k[9],
-            &k[10],
-            &k[11],
-            &k[12],
-            &k[13],
-            &k[14],
-            &k[15],
-        ]
-    }
-}
+/// dop853's sixteen stages in lanes: 1–12 of the step, 13 at its end, 14–16 of its dense
+/// output.
+pub(crate) struct Dop853Lanes<L: Lane, const DIM: usize>(Stages<L, DIM, 16>);
 
 /// Whether every component of `v` is finite, per lane.
 #[inline(always)]
@@ -337,16 +332,12 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
 
     #[inline(always)]
     fn zeroed() -> Self {
-        let z = L::splat(0.0);
-        Dop853Lanes {
-            k: [[z; DIM]; 16],
-            k_start: [z; DIM],
-        }
+        Dop853Lanes(Stages::zeroed())
     }
 
     #[inline(always)]
     fn first_stage(&mut self) -> &mut [L; DIM] {
-        &mut self.k[0]
+        &mut self.0.k[0]
     }
 
     #[inline(always)]
@@ -360,7 +351,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
         h_max: L,
         span: L,
     ) -> L {
-        let [k1, k2, ..] = &mut self.k;
+        let [k1, k2, ..] = &mut self.0.k;
         dop853::initial_step(
             rhs,
             &PlainCombine,
@@ -386,8 +377,8 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
         stage: &mut [L; DIM],
         (atol, rtol): (L, L),
     ) -> L {
-        dop853::stages(rhs, &PlainCombine, t, h, y, &mut self.k, stage);
-        let k = &self.k;
+        dop853::stages(rhs, &PlainCombine, t, h, y, &mut self.0.k, stage);
+        let k = &self.0.k;
         let stages = [&k[0], &k[5], &k[6], &k[7], &k[8], &k[9], &k[10], &k[11]].map(|s| &s[..]);
         let z = L::splat(0.0);
         let (mut scaled3, mut scaled5) = ([z; DIM], [z; DIM]);
@@ -404,8 +395,8 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
 
     #[inline(always)]
     fn end_stage(&mut self, rhs: &mut impl StageRhs<L>, t_new: L, y_new: &[L; DIM]) -> L::Mask {
-        rhs.eval(t_new, y_new, &mut self.k[12]);
-        all_finite(&self.k[12])
+        rhs.eval(t_new, y_new, &mut self.0.k[12]);
+        all_finite(&self.0.k[12])
     }
 
     #[inline(always)]
@@ -415,14 +406,8 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
 
     #[inline(always)]
     fn accept(&mut self, accept: L::Mask, observed: bool, y: &mut [L; DIM], y_new: &[L; DIM]) {
-        if observed {
-            self.k_start = self.k[0];
-        }
-        for j in 0..DIM {
-            y[j] = L::select(accept, y_new[j], y[j]);
-            // First same as last: stage 13 is f at the new point.
-            self.k[0][j] = L::select(accept, self.k[12][j], self.k[0][j]);
-        }
+        // Stage 13 is f at the new point.
+        self.0.accept(accept, observed, y, y_new, 12);
     }
 
     #[inline(always)]
@@ -435,10 +420,11 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
         stage: &mut [L; DIM],
     ) -> L::Mask {
         // The step's first stage back in place while its dense stages are evaluated.
-        std::mem::swap(&mut self.k[0], &mut self.k_start);
-        dop853::dense_stages(rhs, &PlainCombine, t, h, y, &mut self.k, stage);
-        std::mem::swap(&mut self.k[0], &mut self.k_start);
-        all_finite(&self.k[13]) & all_finite(&self.k[14]) & all_finite(&self.k[15])
+        let Stages { k, k_start } = &mut self.0;
+        std::mem::swap(&mut k[0], k_start);
+        dop853::dense_stages(rhs, &PlainCombine, t, h, y, k, stage);
+        std::mem::swap(&mut k[0], k_start);
+        all_finite(&k[13]) & all_finite(&k[14]) & all_finite(&k[15])
     }
 
     type Dense = [[L; DIM]; 8];
@@ -446,7 +432,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
     #[inline(always)]
     fn dense(&self, h: L, y: &[L; DIM], y_new: &[L; DIM]) -> Self::Dense {
         let mut cont = [[L::splat(0.0); DIM]; 8];
-        dop853::dense_coefficients(h, y, y_new, &self.step_stages(), &mut cont);
+        dop853::dense_coefficients(h, y, y_new, &self.0.step_stages(), &mut cont);
         cont
     }
 
@@ -462,7 +448,7 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
         y: &[f64; DIM],
         y_new: &[f64; DIM],
     ) -> LaneInterpolant<DIM> {
-        let k = gather(self.step_stages(), i);
+        let k = gather(self.0.step_stages(), i);
         let mut cont = [[0.0; DIM]; 8];
         dop853::dense_coefficients(h, y, y_new, &k, &mut cont);
         LaneInterpolant::Dop853(cont)
