@@ -21,7 +21,10 @@
 //! [`integrate_runs`] picks the engine at run time: eight f64 lanes compiled for AVX-512
 //! where the processor has it ([`Engine::Avx512`]), else four compiled for AVX2
 //! ([`Engine::Avx2`]), both asked through [`crate::cpu`], otherwise one lane
-//! ([`Engine::Scalar`]).
+//! ([`Engine::Scalar`]). Everything an engine steps with is inlined into its one function,
+//! compiled for its instruction set, except the right-hand side of a class that asks for it
+//! out of line ([`LaneRun::RHS_OUT_OF_LINE`]): then each engine has one copy of it, compiled
+//! for the same instruction set, where inlined it would be copied into every stage.
 //! [`integrate_runs_observed`] also hands each accepted step of each lane ([`LaneStep`], with
 //! the rest of it read out of the lanes on request: [`StepInLanes`]) to an observer that may
 //! end the run: the campaigns' run monitor (samples, events,
