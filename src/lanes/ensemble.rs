@@ -779,7 +779,18 @@ struct Solving<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> {
     solved: L::Mask,
 }
 
-impl<L: Lane, R: LaneRun<DIM>, const DIM: usize> Solving<'_, L, R, DIM> {
+impl<'a, L: Lane, R: LaneRun<DIM>, const DIM: usize> Solving<'a, L, R, DIM> {
+    /// `system`'s right-hand side as the stages call it (`compiled`: the engine's copy), no
+    /// lane declined yet.
+    #[inline(always)]
+    fn new(system: &'a R::System<L>, compiled: CompiledRhs<L, R, DIM>) -> Self {
+        Solving {
+            system,
+            compiled,
+            solved: L::Mask::splat(true),
+        }
+    }
+
     /// The right-hand side at `y` into `dydt`: inlined, or the engine's copy out of line
     /// ([`LaneRun::RHS_OUT_OF_LINE`]); the lanes whose closed form was solved.
     #[inline(always)]
@@ -1062,12 +1073,8 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     fn start(&mut self, starting: L::Mask) {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let mut first = [zero; DIM];
-        let solved = Solving::<L, R, DIM> {
-            system: &self.system,
-            compiled: self.compiled_rhs,
-            solved: L::Mask::splat(true),
-        }
-        .call(&self.y, &mut first);
+        let solved =
+            Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs).call(&self.y, &mut first);
         self.rhs_evaluations += L::select(starting, one, zero);
         let mut finite = L::Mask::splat(true);
         let k1 = self.method.first_stage();
@@ -1086,11 +1093,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             });
         }
         let starting = starting & self.running;
-        let mut rhs = Solving::<L, R, DIM> {
-            system: &self.system,
-            compiled: self.compiled_rhs,
-            solved: L::Mask::splat(true),
-        };
+        let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
         let h = self.method.initial_step(
             &mut rhs,
             self.t,
@@ -1192,11 +1195,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         if !needed.any() {
             return;
         }
-        let mut rhs = Solving::<L, R, DIM> {
-            system: &self.system,
-            compiled: self.compiled_rhs,
-            solved: L::Mask::splat(true),
-        };
+        let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
         let finite = self.method.dense_stages(
             &mut rhs,
             self.t_prev,
@@ -1238,11 +1237,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             });
         }
         let h = end.h;
-        let mut rhs = Solving::<L, R, DIM> {
-            system: &self.system,
-            compiled: self.compiled_rhs,
-            solved: L::Mask::splat(true),
-        };
+        let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
         let err = self.method.attempt(
             &mut rhs,
             self.t,
@@ -1264,11 +1259,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         let passed = running & err_finite & err.at_most(one);
         let mut end_finite = L::Mask::splat(true);
         if M::END_STAGE && passed.any() {
-            let mut rhs = Solving::<L, R, DIM> {
-                system: &self.system,
-                compiled: self.compiled_rhs,
-                solved: L::Mask::splat(true),
-            };
+            let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
             let finite = self.method.end_stage(&mut rhs, end.t_new, &self.y_new);
             end_finite = !passed | finite;
             self.rhs_evaluations += L::select(passed, one, zero);
