@@ -36,6 +36,10 @@ pub struct RodConstants<L> {
     pub m1: L,
     /// m₂ = m L²/3 (kg m²).
     pub m2: L,
+    /// 1/m₂ (1/(kg m²)), divided once: the flap's row is over it.
+    pub inverse_m2: L,
+    /// m₁/m₂ (1/m), divided once.
+    pub m1_over_m2: L,
     /// μ = m₁²/m₂ (kg).
     pub mu: L,
     /// m − μ (kg).
@@ -92,13 +96,12 @@ pub struct RodMomentum<L> {
     pub kinetic_energy: L,
 }
 
-/// One row of W for the freedom whose ∂ê/∂θ is `j`, whose inertia is `mass_k` (kg m²) and
-/// generalised force `q_k` (N m): [(Q − j·F_s) / M_kk, m₁ j / M_kk, (p₂ × j) / M_kk], with
-/// p₂ = m₁ h + m₂ ê and F_s the rod's inertial force per unit of m₂ (written out, without
-/// loops or closures, for the AVX-512 lanes).
+/// One row of W for the freedom whose ∂ê/∂θ is `j`, whose inertia's reciprocal is `inv`
+/// (1/(kg m²)) and generalised force `q_k` (N m): [(Q − j·F_s) / M_kk, m₁ j / M_kk,
+/// (p₂ × j) / M_kk], with p₂ = m₁ h + m₂ ê and F_s the rod's inertial force per unit of m₂
+/// (written out, without loops or closures, for the AVX-512 lanes).
 #[inline(always)]
-fn row<L: Lane>(j: [L; 3], mass_k: L, q_k: L, m1: L, p2: [L; 3], force_s: [L; 3]) -> [L; 7] {
-    let inv = L::splat(1.0) / mass_k;
+fn row<L: Lane>(j: [L; 3], inv: L, q_k: L, m1: L, p2: [L; 3], force_s: [L; 3]) -> [L; 7] {
     let torque = cross(p2, j);
     [
         (q_k - dot(j, force_s)) * inv,
@@ -163,7 +166,7 @@ impl<L: Lane> RodConstants<L> {
                 scale(self.hinge_mass, a_h),
                 scale(mu * dot(e, a_h) + m1 * lambda, e),
             ),
-            scale(m1 / m2, joint),
+            scale(self.m1_over_m2, joint),
         );
         let hinge_moment = add(cross(h, hinge_force), cross(e, joint));
         let he = cross(h, e);
@@ -173,8 +176,10 @@ impl<L: Lane> RodConstants<L> {
             sub(scale(dot(omega, p2), omega), scale(w2, p2)),
             scale(m2, relative),
         );
-        let flap = row(e_f, m2, q_flap, m1, p2, force_s);
-        let lag = row(e_l, m2 * cos2, q_lag, m1, p2, force_s);
+        // The flap's inertia is m₂, whose reciprocal is a constant (the same bits as dividing
+        // here); the lag's, m₂ cos² θ_f.
+        let flap = row(e_f, self.inverse_m2, q_flap, m1, p2, force_s);
+        let lag = row(e_l, L::splat(1.0) / (m2 * cos2), q_lag, m1, p2, force_s);
         let rows = [
             flap[0], flap[1], flap[2], flap[3], flap[4], flap[5], flap[6], lag[0], lag[1], lag[2],
             lag[3], lag[4], lag[5], lag[6],

@@ -59,6 +59,10 @@ pub struct RodLanes {
     m1: Lanes,
     /// m₂ = m L²/3 (kg m²).
     m2: Lanes,
+    /// 1/m₂ (1/(kg m²)).
+    inverse_m2: Lanes,
+    /// m₁/m₂ (1/m).
+    m1_over_m2: Lanes,
     /// μ = m₁²/m₂ (kg).
     mu: Lanes,
     /// m − μ (kg).
@@ -90,6 +94,8 @@ impl RodLanes {
             binormal: zero,
             m1: [0.0; LANES],
             m2: [0.0; LANES],
+            inverse_m2: [0.0; LANES],
+            m1_over_m2: [0.0; LANES],
             mu: [0.0; LANES],
             hinge_mass: [0.0; LANES],
             stiffness: [[0.0; LANES]; 2],
@@ -111,6 +117,8 @@ impl RodLanes {
             set_lane(&mut group.binormal, r, &rod.axis.cross(&rod.direction));
             group.m1[r] = m1;
             group.m2[r] = m2;
+            group.inverse_m2[r] = 1.0 / m2;
+            group.m1_over_m2[r] = m1 / m2;
             group.mu[r] = mu;
             group.hinge_mass[r] = rod.mass - mu;
             for k in 0..2 {
@@ -151,6 +159,8 @@ impl RodLanes {
             binormal: at(&self.binormal),
             m1: self.m1[r],
             m2: self.m2[r],
+            inverse_m2: self.inverse_m2[r],
+            m1_over_m2: self.m1_over_m2[r],
             mu: self.mu[r],
             hinge_mass: self.hinge_mass[r],
             stiffness: [self.stiffness[0][r], self.stiffness[1][r]],

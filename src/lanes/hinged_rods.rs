@@ -184,6 +184,8 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
             binormal: [z; 3],
             m1: z,
             m2: z,
+            inverse_m2: z,
+            m1_over_m2: z,
             mu: z,
             hinge_mass: z,
             stiffness: [z; 2],
@@ -234,6 +236,8 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
             set3(&mut lanes.binormal, &rod.binormal);
             set(&mut lanes.m1, rod.m1);
             set(&mut lanes.m2, rod.m2);
+            set(&mut lanes.inverse_m2, rod.inverse_m2);
+            set(&mut lanes.m1_over_m2, rod.m1_over_m2);
             set(&mut lanes.mu, rod.mu);
             set(&mut lanes.hinge_mass, rod.hinge_mass);
             for k in 0..2 {
