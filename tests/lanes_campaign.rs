@@ -285,3 +285,57 @@ fn a_hinged_rods_campaign_gives_the_scalar_rows_in_lanes() {
         );
     }
 }
+
+/// The driven-wheel class, whose runs stop at breakpoints: scenarios/momentum-transfer.yaml's
+/// wheel spun up by a stepped torque, with dispersed rates, inertia and the torque's first
+/// step, runs of different lengths (ending before, between and after the steps), and a
+/// terminal event that stops some of them, with dop853 and dopri5. Each lane stops exactly on
+/// its own run's steps and restarts there while the others step on.
+#[test]
+fn a_stepped_wheel_campaign_stops_at_its_breakpoints_in_lanes() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/momentum-transfer.yaml");
+    let text = std::fs::read_to_string(&path).expect("the scenario");
+    for integrator in [
+        "{method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+        "{method: dopri5, rtol: 1.0e-8, atol: 1.0e-10}",
+    ] {
+        let mut yaml = text.clone();
+        for (from, to) in [
+            (
+                "integrator: {method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+                format!(
+                    "integrator: {integrator}\nstop: [{{nutation_angle_deg: {{below: 12.0}}}}]"
+                ),
+            ),
+            ("runs: 200", "runs: 12".into()),
+            (
+                "steps: [[0.0, 0.02], [600.0, 0.01], [1200.0, 0.0]]",
+                "steps: [[0.0, 0.04], [150.0, 0.02], [300.0, 0.0], [300.0000000000001, 0.0]]"
+                    .into(),
+            ),
+            ("duration: 1500.0", "duration: 500.0".into()),
+            (
+                "probability_by: [1000, 1500]",
+                "probability_by: [200, 500]".into(),
+            ),
+            (
+                "    - {inertia: {sd: 0.03, axes_sd_deg: 0.5}}\n",
+                "    - {inertia: {sd: 0.03, axes_sd_deg: 0.5}}\n    \
+                 - {path: duration, uniform: {min: 100.0, max: 500.0}}\n"
+                    .into(),
+            ),
+        ] {
+            assert!(yaml.contains(from), "the scenario has `{from}`");
+            yaml = yaml.replace(from, &to);
+        }
+        let sc = scenario::parse(Path::new("wheel.yaml"), yaml, &Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let p = Prepared::new(sc, "wheel.yaml", None, None).unwrap_or_else(|e| panic!("{e}"));
+        let rows = assert_same_rows(p);
+        let stopped = rows.iter().filter(|r| r.message.contains("below")).count();
+        assert!(
+            stopped > 0 && stopped < 12,
+            "{integrator}: {stopped} of 12 runs stopped: the case should mix both"
+        );
+    }
+}

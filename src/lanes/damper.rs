@@ -205,6 +205,7 @@ impl<L: Lane> LaneSystem<L, DIM, DamperRun> for DamperLanes<L> {
             zero + half * d.stiffness * q * q,
             zero + y[9],
             zero + d.damping * u * u,
+            zero + zero,
         ];
         LaneObservation::of_hub([y[3], y[4], y[5], y[6]], h, energies, self.spin_axis)
     }

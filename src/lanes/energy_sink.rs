@@ -161,6 +161,7 @@ impl<L: Lane> LaneSystem<L, DIM, SinkRun> for SinkLanes<L> {
             zero + zero,
             zero + y[7],
             zero + self.power(self.transverse_rate(w)),
+            zero + zero,
         ];
         LaneObservation::of_hub([y[3], y[4], y[5], y[6]], h, energies, self.spin_axis)
     }

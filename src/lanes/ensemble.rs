@@ -28,8 +28,12 @@
 //! [`integrate_runs_observed`] also hands each accepted step of each lane ([`LaneStep`], with
 //! the rest of it read out of the lanes on request: [`StepInLanes`]) to an observer that may
 //! end the run: the campaigns' run monitor (samples, events,
-//! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs). Not
-//! here: breakpoints (a scene with one takes no class).
+//! invariants, checks) reads the lanes' steps through it (`polhode::sim`'s lane runs).
+//!
+//! A class whose runs have breakpoints ([`LaneRun::BREAKPOINTS`]) has each lane's steps end
+//! exactly on its run's next breakpoint, as the scalar loop's do; there the lane restarts
+//! before its next step (held states updated, first stage evaluated afresh, the step size
+//! kept), while the other lanes step on.
 
 use super::methods::{Dop853, Dopri5, LaneMethod, MethodFamily};
 pub use super::methods::{LaneInterpolant, LaneMethodKind};
@@ -61,6 +65,18 @@ pub trait LaneRun<const DIM: usize>: Sized {
     /// fifteen-odd inlined copies per method and lane type would make the engines' code
     /// megabytes long and the build minutes longer.
     const RHS_OUT_OF_LINE: bool = false;
+    /// Whether the class's runs may stop at breakpoints ([`LaneRun::next_stop`]); without
+    /// them the engine does no breakpoint work at all.
+    const BREAKPOINTS: bool = false;
+    /// Where a step from `t` (s) must end at the latest: the run's first breakpoint after
+    /// `t`, where its right-hand side jumps (merged with any a few ulps from it, as the scalar
+    /// loop merges them: `sim::next_stop_of`), or its end time.
+    fn next_stop(&self, _t: f64) -> f64 {
+        self.t_end()
+    }
+    /// At the breakpoint `t` (s) the run has stopped on, its held states in `y` take their
+    /// new values (the scalar `Spacecraft::at_breakpoint`).
+    fn at_breakpoint(&self, _t: f64, _y: &mut [f64; DIM]) {}
 }
 
 /// The parameters of the runs of class `R` in the lanes, one run per lane, and what the
@@ -143,6 +159,9 @@ pub struct LaneStep {
     /// nutation angle at each (of an observed integration whose grid observation is
     /// [`GridObservation::NutationAngle`]; empty otherwise).
     pub later_samples: Vec<GridAngle>,
+    /// Whether the run restarted at a breakpoint before this step (its held states updated,
+    /// its first stage evaluated afresh), as the scalar loop's `Stepper::restart` does.
+    pub restarted: bool,
 }
 
 /// What an observed integration computes at the output grid time inside a step.
@@ -201,6 +220,9 @@ pub struct LaneObservation<T = f64> {
     pub dissipated_energy: T,
     /// The effectors' dissipation rate (W).
     pub dissipation_power: T,
+    /// The work done on the spacecraft from outside its energy account (J): a motor's
+    /// (`EnergyAccount::work`).
+    pub external_work: T,
     /// |H| (N m s), nalgebra's norm of `h_body`.
     pub h_norm: T,
     /// The nutation angle (rad), between the spin axis a and H, from |a × H| and a · H, as
@@ -230,6 +252,7 @@ pub(crate) fn assert_lane_is_observation(
         (o.elastic_energy, s.elastic_energy),
         (o.dissipated_energy, s.dissipated_energy),
         (o.dissipation_power, s.dissipation_power),
+        (o.external_work, s.external_work),
         (o.q_norm_error, s.q_norm_error),
         (o.h_norm, s.h_norm),
         (o.nutation_angle, s.nutation_angle),
@@ -249,13 +272,14 @@ pub(crate) fn assert_lane_is_observation(
 impl<L: Lane> LaneObservation<L> {
     /// The observation of a hub whose integrated quaternion is `q` (w, x, y, z; not yet of
     /// unit norm) and whose system has angular momentum `h` (body axes, N m s), with the
-    /// energies `[kinetic, elastic, dissipated, dissipation power]` (J, J, J, W), the nutation
+    /// energies `[kinetic, elastic, dissipated, dissipation power, external work]` (J, J, J,
+    /// W, J), the nutation
     /// angle measured from `spin_axis` (body axes, unit), with the operations of
     /// `observe::invariants` and `Observation::from_invariants`: nalgebra's 4-vector norm
     /// `(x² + z²) + (y² + w²)`, its rotation `(2 (u × h) w + u × t) + h`, its 3-vector norm,
     /// and the arctangent of [`super::elementary::half_plane_atan2`].
     #[inline(always)]
-    pub fn of_hub(q: [L; 4], h: [L; 3], energies: [L; 4], spin_axis: [L; 3]) -> Self {
+    pub fn of_hub(q: [L; 4], h: [L; 3], energies: [L; 5], spin_axis: [L; 3]) -> Self {
         use linalg::cross;
         let [qw, qi, qj, qk] = q;
         let q_norm = ((qi * qi + qk * qk) + (qj * qj + qw * qw)).sqrt();
@@ -271,6 +295,7 @@ impl<L: Lane> LaneObservation<L> {
             elastic_energy,
             dissipated_energy,
             dissipation_power,
+            external_work,
         ] = energies;
         let a = spin_axis;
         LaneObservation {
@@ -282,6 +307,7 @@ impl<L: Lane> LaneObservation<L> {
             elastic_energy,
             dissipated_energy,
             dissipation_power,
+            external_work,
             h_norm: linalg::norm(h),
             nutation_angle: super::elementary::half_plane_atan2(
                 linalg::norm(cross(a, h)),
@@ -299,6 +325,7 @@ impl<L: Lane> LaneObservation<L> {
             elastic_energy: read(&self.elastic_energy, i),
             dissipated_energy: read(&self.dissipated_energy, i),
             dissipation_power: read(&self.dissipation_power, i),
+            external_work: read(&self.external_work, i),
             h_norm: read(&self.h_norm, i),
             nutation_angle: read(&self.nutation_angle, i),
             ..LaneObservation::default()
@@ -313,9 +340,9 @@ impl<L: Lane> LaneObservation<L> {
 /// A run's drift at a state from its start (t = 0), computed in the lanes with the operations
 /// (and their order) of the run monitor's drift check (`sim::Reference`), so that each term is
 /// bit for bit the scalar path's: |H₀| is the body-frame |H| at t = 0 (nalgebra's norm,
-/// `√(0 + ((x² + y²) + z²))`), E is kinetic + elastic + dissipated energy, and the classes
-/// the lanes have carry no momentum out and have no external work (the scalar sums add their zeros). `T` is
-/// one value ([`f64`]) or one per lane.
+/// `√(0 + ((x² + y²) + z²))`), E is kinetic + elastic + dissipated energy less the external
+/// work, and no class carries momentum out (the scalar sum adds its zeros). `T` is one value
+/// ([`f64`]) or one per lane.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct LaneDrift<T = f64> {
     /// |(|H_N| − |H₀|)| / |H₀| (|H₀| = 0: not divided).
@@ -359,11 +386,11 @@ fn relative<L: Lane>(d: L, reference: L) -> L {
 }
 
 impl<L: Lane> LaneObservation<L> {
-    /// The energy balance, kinetic + elastic + dissipated − external work (none here), in
-    /// the order of `Invariants::energy_balance`.
+    /// The energy balance, kinetic + elastic + dissipated − external work, in the order of
+    /// `Invariants::energy_balance`.
     #[inline(always)]
     fn energy_balance(&self) -> L {
-        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - L::splat(0.0)
+        self.kinetic_energy + self.elastic_energy + self.dissipated_energy - self.external_work
     }
 
     /// H_N plus the (zero) momentum carried out, as the monitor audits it.
@@ -836,6 +863,14 @@ struct Lanes<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> 
     /// Start of the last accepted step (s), when observed.
     t_prev: L,
     t_end: L,
+    /// Where the next step must end at the latest: the run's next breakpoint, or `t_end`
+    /// ([`LaneRun::next_stop`]).
+    t_stop: L,
+    /// The lanes whose last accepted step ended on a breakpoint, to restart before their
+    /// next step ([`Lanes::restart_at_breakpoints`]).
+    on_breakpoint: L::Mask,
+    /// The lanes that restarted at a breakpoint since their last accepted step.
+    restarted: L::Mask,
     /// The controller's proposal (s).
     h: L,
     fac_old: L,
@@ -898,6 +933,9 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             t: z,
             t_prev: z,
             t_end: z,
+            t_stop: z,
+            on_breakpoint: L::Mask::splat(false),
+            restarted: L::Mask::splat(false),
             h: z,
             fac_old: z,
             y: [z; DIM],
@@ -940,6 +978,16 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         }
         set(&mut self.t, 0.0);
         set(&mut self.t_end, run.t_end());
+        set(
+            &mut self.t_stop,
+            if R::BREAKPOINTS {
+                run.next_stop(0.0)
+            } else {
+                run.t_end()
+            },
+        );
+        self.on_breakpoint = self.on_breakpoint.with_lane(i, false);
+        self.restarted = self.restarted.with_lane(i, false);
         // Finite and non-negative, or no grid.
         let rate = run.sample_rate();
         let rate = if rate > 0.0 && rate.is_finite() {
@@ -1010,6 +1058,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
                 });
             }
         }
+        step.restarted = R::BREAKPOINTS && self.restarted.test(i);
         step.stats = Stats {
             steps: read(&self.steps, i) as u64,
             rejected_steps: read(&self.rejected, i) as u64,
@@ -1071,6 +1120,33 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     /// `Dopri5::step` does on its first call.
     #[inline(always)]
     fn start(&mut self, starting: L::Mask) {
+        self.first_stage(starting);
+        let starting = starting & self.running;
+        let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
+        let h = self.method.initial_step(
+            &mut rhs,
+            self.t,
+            &self.y,
+            &mut self.stage,
+            (self.atol, self.rtol),
+            self.h_max,
+            self.t_stop - self.t,
+        );
+        let solved = rhs.solved;
+        let (zero, one) = (L::splat(0.0), L::splat(1.0));
+        self.rhs_evaluations += L::select(starting, one, zero);
+        self.h = L::select(starting, h, self.h);
+        let declined = starting & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+    }
+
+    /// The first stage f(t, y) of the lanes of `starting`, counted, as a scalar method's step
+    /// evaluates it at a run's start and after a restart; ends the lanes where it is declined
+    /// or not finite.
+    #[inline(always)]
+    fn first_stage(&mut self, starting: L::Mask) {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         let mut first = [zero; DIM];
         let solved =
@@ -1092,24 +1168,44 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
                 LaneStatus::Failed(StepError::NonFiniteDerivative { t: s.t.lane(i) })
             });
         }
-        let starting = starting & self.running;
-        let mut rhs = Solving::<L, R, DIM>::new(&self.system, self.compiled_rhs);
-        let h = self.method.initial_step(
-            &mut rhs,
-            self.t,
-            &self.y,
-            &mut self.stage,
-            (self.atol, self.rtol),
-            self.h_max,
-            self.t_end - self.t,
-        );
-        let solved = rhs.solved;
-        self.rhs_evaluations += L::select(starting, one, zero);
-        self.h = L::select(starting, h, self.h);
-        let declined = starting & !solved;
-        if declined.any() {
-            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+    }
+
+    /// Restarts the lanes of `stopped`, whose last accepted step ended on a breakpoint of
+    /// their run (`runs[held[i]]`), as the scalar loop does before their next step: the
+    /// step's dense stages evaluated if they were not (dop853's `restart` completes the dense
+    /// output, counted, when observed), the held states updated
+    /// ([`LaneRun::at_breakpoint`]), the next stop found, and the first stage evaluated
+    /// afresh at the new state; the step size is kept. Rare (a few times in a run), so the
+    /// runs' own functions are called lane by lane.
+    #[cold]
+    #[inline(never)]
+    fn restart_at_breakpoints(
+        &mut self,
+        stopped: L::Mask,
+        observed: bool,
+        runs: &[R],
+        held: &[Option<usize>],
+    ) {
+        if observed {
+            self.prepare_dense(stopped);
         }
+        let mut y = [0.0; DIM];
+        for (i, slot) in held.iter().enumerate() {
+            let Some(index) = *slot else { continue };
+            if !stopped.test(i) {
+                continue;
+            }
+            let (run, t) = (&runs[index], self.t.lane(i));
+            L::gather_lane(&self.y, i, &mut y);
+            run.at_breakpoint(t, &mut y);
+            for (lane, &v) in self.y.iter_mut().zip(&y) {
+                *lane = lane.with_lane(i, v);
+            }
+            self.t_stop = self.t_stop.with_lane(i, run.next_stop(t));
+        }
+        self.first_stage(stopped);
+        self.on_breakpoint = self.on_breakpoint & !stopped;
+        self.restarted = self.restarted | stopped;
     }
 
     /// For the lanes of `accepted` that have just taken a step: the first time of the run's
@@ -1221,7 +1317,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     #[inline(always)]
     fn attempt(&mut self, observed: bool) -> L::Mask {
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
-        let end = adaptive_step_end(self.t, self.h.min(self.h_max), self.t_end);
+        let end = adaptive_step_end(self.t, self.h.min(self.h_max), self.t_stop);
         let underflow = end.underflow & self.running;
         if underflow.any() {
             self.end(underflow, |s, i| {
@@ -1332,6 +1428,11 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         if done.any() {
             self.end(done, |_, _| LaneStatus::Complete);
         }
+        if R::BREAKPOINTS {
+            // As the scalar loop: a step that ended exactly on its stop short of the end.
+            self.on_breakpoint = self.on_breakpoint
+                | (accept & self.t.equals(self.t_stop) & self.t_stop.less_than(self.t_end));
+        }
         accept
     }
 }
@@ -1391,6 +1492,12 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
             }
             lanes.start(starting);
         }
+        if R::BREAKPOINTS {
+            let stopped = lanes.on_breakpoint & lanes.running;
+            if stopped.any() {
+                lanes.restart_at_breakpoints(stopped, observe.is_some(), runs, &held);
+            }
+        }
         if lanes.running.any() {
             let accepted = lanes.attempt(observe.is_some());
             if let Some(observe) = observe.as_mut() {
@@ -1408,6 +1515,9 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
                         }
                     }
                 }
+            }
+            if R::BREAKPOINTS {
+                lanes.restarted = lanes.restarted & !accepted;
             }
         }
         for (i, status) in std::mem::take(&mut lanes.ended) {

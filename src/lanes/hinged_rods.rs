@@ -374,7 +374,7 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
         LaneObservation::of_hub(
             [y[3], y[4], y[5], y[6]],
             h,
-            [kinetic, elastic, dissipated, power],
+            [kinetic, elastic, dissipated, power, zero + zero],
             self.spin_axis,
         )
     }

@@ -808,6 +808,22 @@ impl Spacecraft {
             && self.grouped.iter().all(|&g| g)
     }
 
+    /// Whether the right-hand side is the hub's rotational equations alone with every
+    /// effector coupled on its own (`couple`, then `derivatives`), solved by the rotational
+    /// block's cofactor inverse: no effector moves mass, none is torque-only or grouped or
+    /// alone in a closed form, and nothing is prescribed, expelled or tidal.
+    pub fn takes_rotational_solve(&self) -> bool {
+        self.motion.is_none()
+            && !self.lone_only
+            && !self.torque_only
+            && !self.translation
+            && self.alone.is_none()
+            && self.tidal_source.is_none()
+            && !self.expels_mass
+            && !self.effectors.is_empty()
+            && self.grouped.iter().all(|&g| !g)
+    }
+
     /// The prescribed hub motion, if any.
     pub fn motion(&self) -> Option<&dyn HubMotion> {
         self.motion.as_deref()

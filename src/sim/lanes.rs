@@ -3,11 +3,12 @@
 //! the same dense output, so a run's outcome is the scalar path's (docs/montecarlo.md, "Lanes
 //! in a campaign").
 //!
-//! Three classes have a lane form ([`LaneForm`]), each integrated by dopri5 or dop853: the
+//! Four classes have a lane form ([`LaneForm`]), each integrated by dopri5 or dop853: the
 //! nutation-damper class ([`crate::lanes::damper`], a rigid hub with one spring–mass damper),
 //! the energy-sink class ([`crate::lanes::energy_sink`], a rigid hub with principal axes and
-//! one energy sink) and the hinged-rods class ([`crate::lanes::hinged_rods`], a hub with four
-//! flap–lag rods). [`lane_form`] says why another scene has none; such a run, or one
+//! one energy sink), the hinged-rods class ([`crate::lanes::hinged_rods`], a hub with four
+//! flap–lag rods) and the driven-wheel class ([`crate::lanes::wheel`], a hub with one wheel
+//! whose motor follows a stepped torque profile, stopping at its steps). [`lane_form`] says why another scene has none; such a run, or one
 //! the lanes decline part-way, takes the scalar path.
 
 use super::method::Adaptive;
@@ -16,6 +17,7 @@ use super::{
     Drift, Method, Outcome, Quantity, Simulation, Sink, Status, diagnose, interior_checks,
 };
 use crate::effectors::energy_sink::EnergySink;
+use crate::effectors::motor_wheel::MotorWheel;
 use crate::effectors::particles::ParticleEffector;
 use crate::effectors::spring_mass::SpringMass;
 use crate::integrate::{Stats, Tolerances};
@@ -26,6 +28,7 @@ use crate::lanes::ensemble::{
     LaneSettings, LaneStatus, LaneStep, StepInLanes, integrate_runs_observed_with,
 };
 use crate::lanes::hinged_rods::{self, RodsRun};
+use crate::lanes::wheel::{self, WheelRun};
 use crate::model::{Invariants, Observation, Spacecraft};
 use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 use std::any::Any;
@@ -157,14 +160,13 @@ fn observation(
     let invariants = Invariants {
         h_body: Vector3::from(lane.h_body),
         h_inertial: Vector3::from(lane.h_inertial),
-        // The class carries nothing out and has no external torque: the scalar sums start
-        // from zero and stay there.
+        // No class carries anything out: the scalar sum starts from zero and stays there.
         h_carried_out: Vector3::zeros(),
         kinetic_energy: lane.kinetic_energy,
         elastic_energy: lane.elastic_energy,
         dissipated_energy: lane.dissipated_energy,
         dissipation_power: lane.dissipation_power,
-        external_work: 0.0,
+        external_work: lane.external_work,
         q_norm_error: lane.q_norm_error,
     };
     let attitude = UnitQuaternion::new_unchecked(Quaternion::new(w, i, j, k));
@@ -189,6 +191,8 @@ pub enum LaneForm {
     EnergySink(SinkRun),
     /// A hub with four flap–lag hinged rods ([`crate::lanes::hinged_rods`]).
     HingedRods(Box<RodsRun>),
+    /// A hub with one wheel driven by a stepped torque profile ([`crate::lanes::wheel`]).
+    Wheel(Box<WheelRun>),
 }
 
 /// `sim` as a run of a class of the lanes and the integration settings it needs, or why it is
@@ -220,16 +224,22 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
         list => {
             return Err(format!(
                 "it has {} effectors, and the lanes have a hub with one spring_mass_damper, \
-                 one energy_sink or {} flap–lag hinged_rods only",
+                 one energy_sink, one wheel or {} flap–lag hinged_rods only",
                 list.len(),
                 hinged_rods::RODS
             ));
         }
     };
+    let any: &dyn Any = one.as_ref();
+    if any.downcast_ref::<MotorWheel>().is_some() {
+        // The one class whose runs stop at breakpoints (its profile's steps).
+        let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
+        let run = WheelRun::new(sc, &y0, sim.duration, sim.output_rate)?;
+        return Ok((LaneForm::Wheel(Box::new(run)), settings(method, a)));
+    }
     if sc.next_breakpoint(0.0).is_some() {
         return Err("it has breakpoints, at which the lanes do not stop".into());
     }
-    let any: &dyn Any = one.as_ref();
     let form = if let Some(d) = any.downcast_ref::<ParticleEffector<SpringMass>>() {
         LaneForm::Damper(damper_run(sim, d.model())?)
     } else if let Some(sink) = any.downcast_ref::<EnergySink>() {
@@ -237,7 +247,7 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
     } else {
         return Err(format!(
             "its effector `{}` ({}) has no lane form (the lanes have the spring_mass_damper, \
-             the energy_sink and four flap–lag hinged_rods together)",
+             the energy_sink, the wheel and four flap–lag hinged_rods together)",
             one.name(),
             one.kind()
         ));
@@ -385,6 +395,16 @@ pub fn run_in_lanes<S: Sink + Default>(
             },
             interrupt,
         ),
+        Some((LaneForm::Wheel(_), _)) => run_class::<S, WheelRun, { wheel::DIM }>(
+            engine,
+            sims,
+            forms,
+            |f| match f {
+                LaneForm::Wheel(run) => Some(*run),
+                _ => None,
+            },
+            interrupt,
+        ),
         None => Ok((0..sims.len()).map(|_| None).collect()),
     }
 }
@@ -451,6 +471,10 @@ fn run_class<S: Sink + Default, R: LaneRun<DIM>, const DIM: usize>(
             if interrupt.load(Ordering::Relaxed) {
                 w.status = Some(Status::Interrupted);
                 return false;
+            }
+            if step.restarted {
+                // As the scalar loop tells its monitor after a restart at a breakpoint.
+                w.monitor.restarted();
             }
             match w
                 .monitor

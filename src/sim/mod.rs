@@ -419,10 +419,20 @@ const COLLAPSE_WINDOW: u64 = 10_000;
 /// ([`crate::integrate::same_instant`]). Otherwise the step between them would be below the
 /// resolution of t and an adaptive method would fail with a step-size underflow.
 fn next_stop(sc: &crate::model::Spacecraft, t: f64, t_end: f64) -> f64 {
-    let Some(mut b) = sc.next_breakpoint(t) else {
+    next_stop_of(|t| sc.next_breakpoint(t), t, t_end)
+}
+
+/// [`next_stop`] for breakpoints given by `next_breakpoint(t)`, the first after `t` (s): the
+/// scalar loop's with a scene's, the lanes' with a run's ([`crate::lanes::ensemble::LaneRun`]).
+pub(crate) fn next_stop_of(
+    next_breakpoint: impl Fn(f64) -> Option<f64>,
+    t: f64,
+    t_end: f64,
+) -> f64 {
+    let Some(mut b) = next_breakpoint(t) else {
         return t_end;
     };
-    while let Some(next) = sc.next_breakpoint(b)
+    while let Some(next) = next_breakpoint(b)
         && crate::integrate::same_instant(b, next)
     {
         b = next;
