@@ -269,6 +269,35 @@ pub(crate) fn assert_lane_is_observation(
     );
 }
 
+/// Asserts that the right-hand side and observation of `system` (four runs of class `R`
+/// loaded) at the states `states` are each lane's scalar `Spacecraft` (`spacecraft[i]`) bit
+/// for bit, every lane solved; `case` names the states in a failure.
+#[cfg(test)]
+pub(crate) fn assert_lanes_are_the_spacecrafts<R: LaneRun<DIM>, const DIM: usize>(
+    system: &R::System<F64x4>,
+    spacecraft: &[&crate::model::Spacecraft],
+    states: &[[f64; DIM]],
+    case: &str,
+) {
+    use crate::integrate::OdeSystem;
+    let y: [F64x4; DIM] = std::array::from_fn(|j| F64x4(std::array::from_fn(|i| states[i][j])));
+    let mut dy = [F64x4::splat(0.0); DIM];
+    let solved = system.rhs(&y, &mut dy);
+    let o = system.observe(&y);
+    for (i, sc) in spacecraft.iter().enumerate() {
+        assert!(solved.test(i), "solved, {case}, lane {i}");
+        let mut expected = [0.0; DIM];
+        sc.rhs(0.0, &states[i], &mut expected);
+        let got: [f64; DIM] = std::array::from_fn(|j| dy[j].lane(i));
+        assert_eq!(
+            got.map(f64::to_bits),
+            expected.map(f64::to_bits),
+            "rhs, {case}, lane {i}"
+        );
+        assert_lane_is_observation(&o, i, &sc.observe(0.0, &states[i]));
+    }
+}
+
 impl<L: Lane> LaneObservation<L> {
     /// The observation of a hub whose integrated quaternion is `q` (w, x, y, z; not yet of
     /// unit norm) and whose system has angular momentum `h` (body axes, N m s), with the

@@ -383,8 +383,8 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrate::OdeSystem;
     use crate::lanes::F64x4;
+    use crate::lanes::ensemble::assert_lanes_are_the_spacecrafts;
     use crate::model::RigidBody;
     use nalgebra::UnitQuaternion;
 
@@ -474,26 +474,10 @@ mod tests {
                 let run = RodsRun::new(sc, &states[i], 1.0, 0.0).expect("of the class");
                 lanes.load(i, &run);
             }
-            let y: [F64x4; DIM] =
-                std::array::from_fn(|j| F64x4(std::array::from_fn(|i| states[i][j])));
-            let mut dy = [F64x4::splat(0.0); DIM];
-            let solved = lanes.rhs(&y, &mut dy);
-            let o = lanes.observe(&y);
-            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            for (i, sc) in scenes.iter().enumerate() {
-                assert!(crate::lanes::LaneMask::test(solved, i), "solved, lane {i}");
-                let mut expected = [0.0; DIM];
-                sc.rhs(0.0, &states[i], &mut expected);
-                let got: [f64; DIM] = std::array::from_fn(|j| dy[j].lane(i));
-                assert_eq!(
-                    bits(&got),
-                    bits(&expected),
-                    "rhs, sample {sample}, lane {i}"
-                );
-                let s = sc.observe(0.0, &states[i]);
-                crate::lanes::ensemble::assert_lane_is_observation(&o, i, &s);
-                checked += 1;
-            }
+            let spacecraft: Vec<_> = scenes.iter().collect();
+            let case = format!("sample {sample}");
+            assert_lanes_are_the_spacecrafts::<RodsRun, DIM>(&lanes, &spacecraft, &states, &case);
+            checked += 4;
         }
         assert_eq!(checked, 160);
     }

@@ -304,8 +304,8 @@ impl<L: Lane> LaneSystem<L, DIM, WheelRun> for WheelLanes<L> {
 mod tests {
     use super::*;
     use crate::effectors::motor::Friction;
-    use crate::integrate::OdeSystem;
     use crate::lanes::F64x4;
+    use crate::lanes::ensemble::assert_lanes_are_the_spacecrafts;
     use crate::model::RigidBody;
     use nalgebra::UnitQuaternion;
 
@@ -375,22 +375,8 @@ mod tests {
                 y
             })
             .collect();
-        let y: [F64x4; DIM] = std::array::from_fn(|j| F64x4(std::array::from_fn(|i| states[i][j])));
-        let mut dy = [F64x4::splat(0.0); DIM];
-        assert!(lanes.rhs(&y, &mut dy).all());
-        let o = lanes.observe(&y);
-        for (i, (sc, _)) in scenes.iter().enumerate() {
-            let mut expected = [0.0; DIM];
-            sc.rhs(0.0, &states[i], &mut expected);
-            let got: [f64; DIM] = std::array::from_fn(|j| dy[j].lane(i));
-            assert_eq!(
-                got.map(f64::to_bits),
-                expected.map(f64::to_bits),
-                "rhs, lane {i}"
-            );
-            let s = sc.observe(0.0, &states[i]);
-            crate::lanes::ensemble::assert_lane_is_observation(&o, i, &s);
-        }
+        let spacecraft: Vec<_> = scenes.iter().map(|(sc, _)| sc).collect();
+        assert_lanes_are_the_spacecrafts::<WheelRun, DIM>(&lanes, &spacecraft, &states, "wheel");
     }
 
     /// The run's stops and held torque are the scalar loop's: the profile's steps, then the
