@@ -292,10 +292,11 @@ fn a_hinged_rods_campaign_gives_the_scalar_rows_in_lanes() {
 }
 
 /// The driven-wheel class, whose runs stop at breakpoints: scenarios/momentum-transfer.yaml's
-/// wheel spun up by a stepped torque, with dispersed rates, inertia and the torque's first
-/// step, runs of different lengths (ending before, between and after the steps), and a
-/// terminal event that stops some of them, with dop853 and dopri5. Each lane stops exactly on
-/// its own run's steps and restarts there while the others step on.
+/// wheel spun up by a stepped torque (its last step two breakpoints 10⁻¹³ s apart, one stop),
+/// with dispersed rates and inertia, the time of the torque's second step dispersed (so each
+/// lane stops at its own times), runs of different lengths (ending before, between and after
+/// the steps), and a terminal event that stops some of them, with dop853 and dopri5. Each
+/// lane stops exactly on its own run's steps and restarts there while the others step on.
 #[test]
 fn a_stepped_wheel_campaign_stops_at_its_breakpoints_in_lanes() {
     for integrator in [
@@ -325,7 +326,9 @@ fn a_stepped_wheel_campaign_stops_at_its_breakpoints_in_lanes() {
                 (
                     "    - {inertia: {sd: 0.03, axes_sd_deg: 0.5}}\n",
                     "    - {inertia: {sd: 0.03, axes_sd_deg: 0.5}}\n    \
-                     - {path: duration, uniform: {min: 100.0, max: 500.0}}\n"
+                     - {path: duration, uniform: {min: 100.0, max: 500.0}}\n    \
+                     - {path: \"effectors[rotor].motor.torque.steps[1][0]\", \
+                     uniform: {min: 100.0, max: 250.0}}\n"
                         .into(),
                 ),
             ],

@@ -1205,9 +1205,10 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     /// output, counted, when observed), the held states updated
     /// ([`LaneRun::at_breakpoint`]), the next stop found, and the first stage evaluated
     /// afresh at the new state; the step size is kept. Rare (a few times in a run), so the
-    /// runs' own functions are called lane by lane.
-    #[cold]
-    #[inline(never)]
+    /// runs' own functions are called lane by lane; inlined all the same, so that the stages
+    /// it evaluates have the engine's instruction set (only a class with breakpoints
+    /// compiles it).
+    #[inline(always)]
     fn restart_at_breakpoints(
         &mut self,
         stopped: L::Mask,
@@ -1218,6 +1219,8 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         if observed {
             self.prepare_dense(stopped);
         }
+        // A lane whose dense stages were declined has ended.
+        let stopped = stopped & self.running;
         let mut y = [0.0; DIM];
         for (i, slot) in held.iter().enumerate() {
             let Some(index) = *slot else { continue };
