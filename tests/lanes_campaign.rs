@@ -336,3 +336,36 @@ fn a_stepped_wheel_campaign_stops_at_its_breakpoints_in_lanes() {
         assert_some_stopped(&assert_same_rows(p), "below", integrator);
     }
 }
+
+/// The driven-wheel class under a sampled controller: one wheel on z under rate damping at
+/// 10 Hz (a breakpoint every 0.1 s, where each lane samples its own ω), its motor saturated
+/// at first, with dispersed rates and durations and a terminal condition, with dop853 and
+/// dopri5.
+#[test]
+fn a_rate_damping_wheel_campaign_restarts_at_every_tick_in_lanes() {
+    for integrator in [
+        "{method: dop853, rtol: 1.0e-10, atol: 1.0e-12}",
+        "{method: dopri5, rtol: 1.0e-8, atol: 1.0e-10}",
+    ] {
+        let yaml = format!(
+            "name: despin\n\
+             body:\n  principal: [12.0, 14.0, 9.0]\n  spin_axis: [0, 0, 1]\n\
+             effectors:\n  - wheel:\n      name: rw\n      axial_inertia: 0.01\n      \
+             axis: [0, 0, 1]\n      max_torque: 0.02\n      friction: {{viscous: 1.0e-6}}\n      \
+             motor: {{rate_damping: {{gain: 0.5, sample_rate: 10.0}}}}\n\
+             initial:\n  omega: [0.002, -0.001, 0.05]\n\
+             integrator: {integrator}\n\
+             duration: 60.0\noutput: {{rate: 5}}\n\
+             events:\n  - {{omega_z: {{below: 0.02, once: true}}}}\n\
+             stop: [{{omega_z: {{below: 0.01}}}}]\n\
+             montecarlo:\n  runs: 10\n  seed: 5\n  dispersions:\n    \
+             - {{path: \"initial.omega[2]\", normal: {{sd: 0.2, relative: true}}}}\n    \
+             - {{path: \"initial.omega[0]\", normal: {{sd: 0.002}}}}\n    \
+             - {{path: duration, uniform: {{min: 5.0, max: 60.0}}}}\n"
+        );
+        let sc = scenario::parse(Path::new("despin.yaml"), yaml, &Overrides::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let p = Prepared::new(sc, "despin.yaml", None, None).unwrap_or_else(|e| panic!("{e}"));
+        assert_some_stopped(&assert_same_rows(p), "below", integrator);
+    }
+}

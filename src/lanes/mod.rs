@@ -23,8 +23,8 @@
 //! AVX-512 dispatch, generic over the class of runs it integrates: [`ensemble::LaneRun`] and
 //! [`ensemble::LaneSystem`]), `methods` (dopri5 and dop853 in lanes), [`damper`] (the
 //! nutation-damper class), [`energy_sink`] (a rigid body with an energy sink), [`hinged_rods`]
-//! (a hub with four flap–lag hinged rods), [`wheel`] (a hub with a wheel driven by a stepped
-//! torque profile: the class with breakpoints). docs/montecarlo.md,
+//! (a hub with four flap–lag hinged rods), [`wheel`] (a hub with a wheel whose motor holds a
+//! stepped profile's or a rate-damping law's command: the class with breakpoints). docs/montecarlo.md,
 //! "Lanes: the foundation", says what is tested and measured.
 
 pub mod damper;

@@ -1,9 +1,11 @@
-//! The driven-wheel class in the lanes: a rigid hub carrying one `wheel` whose motor follows
-//! a stepped torque profile (`motor: {torque: {steps: …}}`), with viscous bearing friction
-//! (the scalar path's `Spacecraft` with that one effector, whose right-hand side couples it
-//! and solves the hub's rotational equations, `Spacecraft::takes_rotational_solve`). The
-//! class has breakpoints: each lane's steps end exactly on its profile's steps, where the
-//! held torque takes its next value and the lane restarts ([`super::ensemble`]).
+//! The driven-wheel class in the lanes: a rigid hub carrying one `wheel` whose motor holds a
+//! torque command between breakpoints, with viscous bearing friction (the scalar path's
+//! `Spacecraft` with that one effector, whose right-hand side couples it and solves the hub's
+//! rotational equations, `Spacecraft::takes_rotational_solve`). The command is a stepped
+//! torque profile (`motor: {torque: {steps: …}}`), changing at its steps, or a rate-damping
+//! law (`motor: {rate_damping: …}`), which samples ω at its clock's ticks and holds u = g·ω
+//! until the next. Each lane's steps end exactly on its run's breakpoints, where the held
+//! torque takes its new value and the lane restarts ([`super::ensemble`]).
 //!
 //! The equations are the wheel's (docs/actuators.md): with the rotor's axial inertia I_a on
 //! the unit axis â, its rate Ω relative to the hub and g = u − f(Ω),
@@ -21,7 +23,7 @@
 
 use super::ensemble::{LaneObservation, LaneRun, LaneSystem};
 use super::{Lane, LaneMask, linalg};
-use crate::effectors::motor::{MotorMode, TorqueProfile};
+use crate::effectors::motor::{MotorMode, RateDamping, TorqueProfile};
 use crate::effectors::motor_wheel::MotorWheel;
 use crate::model::Spacecraft;
 use nalgebra::{Matrix3, Vector3};
@@ -48,8 +50,8 @@ pub struct WheelRun {
     pub max_torque: f64,
     /// The bearing's viscous friction coefficient c (N m s/rad).
     pub viscous: f64,
-    /// The motor's stepped torque profile.
-    pub profile: TorqueProfile,
+    /// What the motor's held torque follows.
+    pub command: HeldCommand,
     /// The inverse of the rotational block I − I_a â âᵀ by columns, as the scalar solve forms
     /// it at every call; `None` where it is not positive definite to rounding.
     pub block_inverse: Option<[[f64; 3]; 3]>,
@@ -61,6 +63,15 @@ pub struct WheelRun {
     pub t_end: f64,
     /// Rate of the output grid (Hz; 0: none): [`LaneRun::sample_rate`].
     pub sample_rate: f64,
+}
+
+/// What a driven wheel's held torque command follows.
+#[derive(Debug, Clone)]
+pub enum HeldCommand {
+    /// A stepped profile: the command changes at its steps.
+    Steps(TorqueProfile),
+    /// A rate-damping law: at each tick of its clock the command becomes g·ω.
+    RateDamping(RateDamping),
 }
 
 impl WheelRun {
@@ -83,12 +94,18 @@ impl WheelRun {
                 effector.kind()
             ));
         };
-        let MotorMode::Torque(profile @ TorqueProfile::Steps(_)) = &wheel.mode else {
-            return Err(
-                "its wheel's motor is not a stepped torque profile (the lanes take \
-                 `motor: {torque: {steps: …}}`)"
-                    .into(),
-            );
+        let command = match &wheel.mode {
+            MotorMode::Torque(profile @ TorqueProfile::Steps(_)) => {
+                HeldCommand::Steps(profile.clone())
+            }
+            MotorMode::RateDamping(law) => HeldCommand::RateDamping(*law),
+            _ => {
+                return Err(
+                    "its wheel's motor holds no command (the lanes take `motor: {torque: \
+                     {steps: …}}` and `motor: {rate_damping: …}`)"
+                        .into(),
+                );
+            }
         };
         if wheel.friction.coulomb != 0.0 {
             return Err("its wheel's bearing has Coulomb friction (the lanes take viscous)".into());
@@ -122,7 +139,7 @@ impl WheelRun {
             axis: wheel.axis,
             max_torque: wheel.max_torque.unwrap_or(f64::INFINITY),
             viscous: wheel.friction.viscous,
-            profile: profile.clone(),
+            command,
             block_inverse: ok.then_some(inverse),
             initial_state,
             spin_axis: sc.spin_axis,
@@ -150,11 +167,22 @@ impl LaneRun<DIM> for WheelRun {
         self.block_inverse.is_some()
     }
     fn next_stop(&self, t: f64) -> f64 {
-        crate::sim::next_stop_of(|t| self.profile.next_breakpoint(t), t, self.t_end)
+        match &self.command {
+            HeldCommand::Steps(profile) => {
+                crate::sim::next_stop_of(|t| profile.next_breakpoint(t), t, self.t_end)
+            }
+            HeldCommand::RateDamping(law) => {
+                crate::sim::next_stop_of(|t| Some(law.clock.next_tick(t)), t, self.t_end)
+            }
+        }
     }
-    /// The held torque takes the profile's value at `t` (`MotorWheel::at_breakpoint`).
+    /// The held torque takes its new value (`MotorWheel::at_breakpoint`): the profile's at
+    /// `t`, or the law's g·ω.
     fn at_breakpoint(&self, t: f64, y: &mut [f64; DIM]) {
-        y[HUB_STATES + 1] = self.profile.at(t);
+        y[HUB_STATES + 1] = match &self.command {
+            HeldCommand::Steps(profile) => profile.at(t),
+            HeldCommand::RateDamping(law) => law.gains.dot(&Vector3::new(y[0], y[1], y[2])),
+        };
     }
 }
 
@@ -309,7 +337,8 @@ mod tests {
     use crate::model::RigidBody;
     use nalgebra::UnitQuaternion;
 
-    /// A hub with products of inertia and one stepped wheel on a tilted axis, of case `k`.
+    /// A hub with products of inertia and one wheel on a tilted axis, of case `k`: stepped,
+    /// or under rate damping at 10 Hz for odd `k` past 1.
     fn scene(k: usize, max_torque: Option<f64>) -> (Spacecraft, WheelRun) {
         let b = k as f64;
         let inertia = Matrix3::new(
@@ -329,7 +358,14 @@ mod tests {
             name: "rotor".into(),
             axial_inertia: 2.0 + 0.5 * b,
             axis: Vector3::new(0.1 * b, -0.05, 1.0).normalize(),
-            mode: MotorMode::Torque(TorqueProfile::Steps(vec![(0.0, 0.4), (3.0, -0.2)])),
+            mode: if k > 1 && k % 2 == 1 {
+                MotorMode::RateDamping(RateDamping {
+                    gains: Vector3::new(0.1, -0.2 * b, -0.5),
+                    clock: crate::effectors::clock::SampleClock { period: 0.1 },
+                })
+            } else {
+                MotorMode::Torque(TorqueProfile::Steps(vec![(0.0, 0.4), (3.0, -0.2)]))
+            },
             max_torque,
             friction: Friction {
                 viscous: 1e-3 * b,
@@ -380,7 +416,8 @@ mod tests {
     }
 
     /// The run's stops and held torque are the scalar loop's: the profile's steps, then the
-    /// end; the held torque takes each step's value there.
+    /// end, the held torque taking each step's value there; or the clock's ticks, the command
+    /// g·ω sampled at each.
     #[test]
     fn the_runs_stops_and_held_torque_are_the_profiles() {
         let (sc, run) = scene(1, None);
@@ -393,5 +430,19 @@ mod tests {
         sc.at_breakpoint(3.0, &mut scalar);
         assert_eq!(y.to_vec(), scalar);
         assert_eq!(y[HUB_STATES + 1], -0.2);
+        // Under rate damping: the clock's ticks k × 0.1 (rounded; two of the times are
+        // ticks), and the command g·ω sampled there.
+        let (sc, run) = scene(3, None);
+        for t in [0.0, 0.25, 0.30000000000000004, 2.9999999999999996] {
+            let scalar_stop = crate::sim::next_stop_of(|t| sc.next_breakpoint(t), t, 10.0);
+            assert_eq!(run.next_stop(t), scalar_stop, "after {t}");
+        }
+        let mut y = run.initial_state();
+        y[0] = -0.7;
+        let mut scalar = y.to_vec();
+        run.at_breakpoint(0.3, &mut y);
+        sc.at_breakpoint(0.3, &mut scalar);
+        assert_eq!(y.to_vec(), scalar);
+        assert_ne!(y[HUB_STATES + 1], run.initial_state()[HUB_STATES + 1]);
     }
 }

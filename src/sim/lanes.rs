@@ -8,8 +8,9 @@
 //! the energy-sink class ([`crate::lanes::energy_sink`], a rigid hub with principal axes and
 //! one energy sink), the hinged-rods class ([`crate::lanes::hinged_rods`], a hub with four
 //! flap–lag rods) and the driven-wheel class ([`crate::lanes::wheel`], a hub with one wheel
-//! whose motor follows a stepped torque profile, stopping at its steps). [`lane_form`] says why another scene has none; such a run, or one
-//! the lanes decline part-way, takes the scalar path.
+//! whose motor holds a command between breakpoints, stopping at each: a stepped profile's
+//! steps, a rate-damping law's ticks). [`lane_form`] says why another scene has none; such a
+//! run, or one the lanes decline part-way, takes the scalar path.
 
 use super::method::Adaptive;
 use super::monitor::{Monitor, StepView};
@@ -191,7 +192,8 @@ pub enum LaneForm {
     EnergySink(SinkRun),
     /// A hub with four flap–lag hinged rods ([`crate::lanes::hinged_rods`]).
     HingedRods(Box<RodsRun>),
-    /// A hub with one wheel driven by a stepped torque profile ([`crate::lanes::wheel`]).
+    /// A hub with one wheel whose motor holds a command between breakpoints: a stepped torque
+    /// profile or a rate-damping law ([`crate::lanes::wheel`]).
     Wheel(Box<WheelRun>),
 }
 
