@@ -1007,14 +1007,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         }
         set(&mut self.t, 0.0);
         set(&mut self.t_end, run.t_end());
-        set(
-            &mut self.t_stop,
-            if R::BREAKPOINTS {
-                run.next_stop(0.0)
-            } else {
-                run.t_end()
-            },
-        );
+        set(&mut self.t_stop, run.next_stop(0.0));
         self.on_breakpoint = self.on_breakpoint.with_lane(i, false);
         self.restarted = self.restarted.with_lane(i, false);
         // Finite and non-negative, or no grid.
@@ -1115,6 +1108,16 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         }
     }
 
+    /// Ends the runs of the lanes of `lanes` whose closed form did not solve (`solved` false)
+    /// as [`LaneStatus::Declined`] at the time they stand at.
+    #[inline(always)]
+    fn decline_unsolved(&mut self, lanes: L::Mask, solved: L::Mask) {
+        let declined = lanes & !solved;
+        if declined.any() {
+            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
+        }
+    }
+
     /// Ends the runs of the lanes in `mask` with the status `status(i)` (kept until collected).
     #[cold]
     #[inline(never)]
@@ -1165,10 +1168,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         let (zero, one) = (L::splat(0.0), L::splat(1.0));
         self.rhs_evaluations += L::select(starting, one, zero);
         self.h = L::select(starting, h, self.h);
-        let declined = starting & !solved;
-        if declined.any() {
-            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
-        }
+        self.decline_unsolved(starting, solved);
     }
 
     /// The first stage f(t, y) of the lanes of `starting`, counted, as a scalar method's step
@@ -1187,10 +1187,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             k1[j] = L::select(starting, f, k1[j]);
             finite = finite & f.is_finite();
         }
-        let declined = starting & !solved;
-        if declined.any() {
-            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
-        }
+        self.decline_unsolved(starting, solved);
         let non_finite = starting & solved & !finite;
         if non_finite.any() {
             self.end(non_finite, |s, i| {
@@ -1377,10 +1374,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
         );
         let solved = rhs.solved;
         self.rhs_evaluations += L::select(self.running, L::splat(M::ATTEMPT_EVALUATIONS), zero);
-        let declined = self.running & !solved;
-        if declined.any() {
-            self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
-        }
+        self.decline_unsolved(self.running, solved);
         let running = self.running;
         let err_finite = err.is_finite();
         // dop853's stage 13 (f at the new point), for the steps that passed the error test.
@@ -1391,10 +1385,7 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             let finite = self.method.end_stage(&mut rhs, end.t_new, &self.y_new);
             end_finite = !passed | finite;
             self.rhs_evaluations += L::select(passed, one, zero);
-            let declined = passed & !rhs.solved;
-            if declined.any() {
-                self.end(declined, |s, i| LaneStatus::Declined { t: s.t.lane(i) });
-            }
+            self.decline_unsolved(passed, rhs.solved);
         }
         let running = self.running;
         let finite = err_finite & end_finite;

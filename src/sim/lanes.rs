@@ -234,7 +234,7 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
     };
     let any: &dyn Any = one.as_ref();
     if any.downcast_ref::<MotorWheel>().is_some() {
-        // The one class whose runs stop at breakpoints (its profile's steps).
+        // The one class whose runs stop at breakpoints (a profile's steps, a law's ticks).
         let y0 = sc.initial_state(&sim.omega0, &sim.attitude0);
         let run = WheelRun::new(sc, &y0, sim.duration, sim.output_rate)?;
         return Ok((LaneForm::Wheel(Box::new(run)), settings(method, a)));
