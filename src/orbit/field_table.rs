@@ -20,6 +20,8 @@ use super::igrf::Coefficients;
 use super::magnetic::decimal_year;
 use crate::chebyshev::{Chebyshev, clenshaw, coefficients};
 use nalgebra::Vector3;
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Chebyshev points per segment.
 pub const NODES: usize = 20;
@@ -70,6 +72,34 @@ pub struct FieldTable {
     first: Vec<usize>,
     end: f64,
     max_error: f64,
+    /// This table's number among the tables built in the process (from 1; a clone keeps it:
+    /// it holds the same field), the key of [`RECENT`].
+    id: u64,
+}
+
+/// Tables built so far in the process.
+static TABLES_BUILT: AtomicU64 = AtomicU64::new(0);
+
+/// Evaluations [`FieldTable::field_eci`] keeps on each thread.
+const RECENT_LEN: usize = 4;
+
+/// The last few evaluations on this thread: (table id, t's bits, B), id 0 for none. A
+/// right-hand side asks one table at the same times once per effector (a magnet at t; each
+/// hysteresis rod at t and t ± its difference step, in its torque and again in its
+/// derivatives), so a run's field costs three evaluations per right-hand side instead of one
+/// per question; each answer is the one the segment gives, bit for bit.
+struct Recent {
+    entries: [(u64, u64, [f64; 3]); RECENT_LEN],
+    next: usize,
+}
+
+thread_local! {
+    static RECENT: RefCell<Recent> = const {
+        RefCell::new(Recent {
+            entries: [(0, 0, [0.0; 3]); RECENT_LEN],
+            next: 0,
+        })
+    };
 }
 
 impl FieldTable {
@@ -114,6 +144,7 @@ impl FieldTable {
             first,
             end: duration,
             max_error,
+            id: TABLES_BUILT.fetch_add(1, Ordering::Relaxed) + 1,
         }))
     }
 
@@ -150,13 +181,28 @@ impl FieldTable {
         if !(0.0..=self.end).contains(&t) {
             return None;
         }
+        let key = (self.id, t.to_bits());
+        RECENT.with_borrow_mut(|recent| {
+            if let Some(&(.., b)) = recent.entries.iter().find(|e| (e.0, e.1) == key) {
+                return Some(Vector3::from(b));
+            }
+            let b = self.evaluate(t);
+            recent.entries[recent.next] = (key.0, key.1, b.into());
+            recent.next = (recent.next + 1) % RECENT_LEN;
+            Some(b)
+        })
+    }
+
+    /// The segments' value at `t` in [0, end] (T, inertial axes).
+    #[inline]
+    fn evaluate(&self, t: f64) -> Vector3<f64> {
         let nominal = ((t / self.nominal) as usize).min(self.first.len() - 1);
         let mut k = self.first[nominal];
         // The pieces of a halved segment: step to the one that holds t.
         while k + 1 < self.segments.len() && self.segments[k + 1].start <= t {
             k += 1;
         }
-        Some(self.segments[k].at(t))
+        self.segments[k].at(t)
     }
 
     /// The largest departure from the harmonics found at the check points (T).
@@ -184,5 +230,44 @@ impl Segment {
             clenshaw(&self.coefficients[1], s),
             clenshaw(&self.coefficients[2], s),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::orbit::{CentralBody, Elements};
+
+    fn table(true_anomaly: f64) -> FieldTable {
+        let elements = Elements::new(6878.137e3, 0.0, 1.7, 0.7, 0.0, true_anomaly);
+        let orbit = Orbit::new(CentralBody::EARTH, elements, true).unwrap();
+        // 2027-03-01 (Unix ns), one hour.
+        FieldTable::build(&orbit, 1_803_945_600_000_000_000, 3600.0)
+            .unwrap()
+            .unwrap()
+    }
+
+    /// The evaluations a thread keeps answer each table with its own segments' value, bit for
+    /// bit: two tables of two orbits asked in turn at the same times, each time asked again
+    /// before and after more times than are kept, and a clone answering as its original.
+    #[test]
+    fn kept_evaluations_answer_each_table_with_its_own_value() {
+        let (a, b) = (table(0.3), table(2.0));
+        let copy = a.clone();
+        let bits = |v: Vector3<f64>| v.map(f64::to_bits);
+        let times: Vec<f64> = (0..3 * RECENT_LEN).map(|k| 0.5 + 97.3 * k as f64).collect();
+        for round in 0..3 {
+            for (k, &t) in times.iter().enumerate() {
+                let t_again = times[k.saturating_sub(round)];
+                for (table, other) in [(&a, &b), (&b, &a), (&copy, &b)] {
+                    for t in [t, t_again, t] {
+                        let value = table.field_eci(t).unwrap();
+                        assert_eq!(bits(value), bits(table.evaluate(t)), "t = {t}");
+                        assert_ne!(bits(value), bits(other.evaluate(t)), "t = {t}");
+                    }
+                }
+            }
+        }
+        assert!(a.field_eci(3601.0).is_none() && a.field_eci(f64::NAN).is_none());
     }
 }

@@ -215,8 +215,8 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
         return Err(format!("{} refuses it ({refusal})", sim.method.name()));
     }
     if sc.effectors().len() == hinged_rods::RODS {
-        if sc.next_breakpoint(0.0).is_some() {
-            return Err("it has breakpoints, at which the lanes do not stop".into());
+        if let Some(reason) = breakpoints_without_lane_form(sc) {
+            return Err(reason);
         }
         let form = LaneForm::HingedRods(Box::new(rods_run(sim)?));
         return Ok((form, settings(method, a)));
@@ -239,8 +239,8 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
         let run = WheelRun::new(sc, &y0, sim.duration, sim.output_rate)?;
         return Ok((LaneForm::Wheel(Box::new(run)), settings(method, a)));
     }
-    if sc.next_breakpoint(0.0).is_some() {
-        return Err("it has breakpoints, at which the lanes do not stop".into());
+    if let Some(reason) = breakpoints_without_lane_form(sc) {
+        return Err(reason);
     }
     let form = if let Some(d) = any.downcast_ref::<ParticleEffector<SpringMass>>() {
         LaneForm::Damper(damper_run(sim, d.model())?)
@@ -255,6 +255,21 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
         ));
     };
     Ok((form, settings(method, a)))
+}
+
+/// Why `sc` has no lane form if it has breakpoints (a scene of a class without them): the
+/// effector that has them, and the one class of the lanes that stops at its own.
+fn breakpoints_without_lane_form(sc: &Spacecraft) -> Option<String> {
+    let e = sc
+        .effectors()
+        .iter()
+        .find(|e| e.next_breakpoint(0.0).is_some())?;
+    Some(format!(
+        "its effector `{}` ({}) has breakpoints, and the one class of the lanes that stops at \
+         its own is a hub with one wheel",
+        e.name(),
+        e.kind()
+    ))
 }
 
 /// The lanes' settings for `method` with the scalar method's settings `a`.
