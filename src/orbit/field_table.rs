@@ -18,10 +18,9 @@ use super::Orbit;
 use super::earth_rotation_angle;
 use super::igrf::Coefficients;
 use super::magnetic::decimal_year;
+use super::recent;
 use crate::chebyshev::{Chebyshev, clenshaw, coefficients};
 use nalgebra::Vector3;
-use std::cell::RefCell;
-use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Chebyshev points per segment.
 pub const NODES: usize = 20;
@@ -72,34 +71,9 @@ pub struct FieldTable {
     first: Vec<usize>,
     end: f64,
     max_error: f64,
-    /// This table's number among the tables built in the process (from 1; a clone keeps it:
-    /// it holds the same field), the key of [`RECENT`].
+    /// This table's identity ([`recent::next_id`]; a clone keeps it), for the answers kept
+    /// per thread ([`recent`]).
     id: u64,
-}
-
-/// Tables built so far in the process.
-static TABLES_BUILT: AtomicU64 = AtomicU64::new(0);
-
-/// Evaluations [`FieldTable::field_eci`] keeps on each thread.
-const RECENT_LEN: usize = 4;
-
-/// The last few evaluations on this thread: (table id, t's bits, B), id 0 for none. A
-/// right-hand side asks one table at the same times once per effector (a magnet at t; each
-/// hysteresis rod at t and t ± its difference step, in its torque and again in its
-/// derivatives), so a run's field costs three evaluations per right-hand side instead of one
-/// per question; each answer is the one the segment gives, bit for bit.
-struct Recent {
-    entries: [(u64, u64, [f64; 3]); RECENT_LEN],
-    next: usize,
-}
-
-thread_local! {
-    static RECENT: RefCell<Recent> = const {
-        RefCell::new(Recent {
-            entries: [(0, 0, [0.0; 3]); RECENT_LEN],
-            next: 0,
-        })
-    };
 }
 
 impl FieldTable {
@@ -144,7 +118,7 @@ impl FieldTable {
             first,
             end: duration,
             max_error,
-            id: TABLES_BUILT.fetch_add(1, Ordering::Relaxed) + 1,
+            id: recent::next_id(),
         }))
     }
 
@@ -181,16 +155,10 @@ impl FieldTable {
         if !(0.0..=self.end).contains(&t) {
             return None;
         }
-        let key = (self.id, t.to_bits());
-        RECENT.with_borrow_mut(|recent| {
-            if let Some(&(.., b)) = recent.entries.iter().find(|e| (e.0, e.1) == key) {
-                return Some(Vector3::from(b));
-            }
-            let b = self.evaluate(t);
-            recent.entries[recent.next] = (key.0, key.1, b.into());
-            recent.next = (recent.next + 1) % RECENT_LEN;
-            Some(b)
-        })
+        // Kind 1: a table (the key names it alone: it was built for one orbit and epoch).
+        Some(recent::kept([1, self.id, 0, t.to_bits()], || {
+            self.evaluate(t)
+        }))
     }
 
     /// The segments' value at `t` in [0, end] (T, inertial axes).
@@ -255,7 +223,9 @@ mod tests {
         let (a, b) = (table(0.3), table(2.0));
         let copy = a.clone();
         let bits = |v: Vector3<f64>| v.map(f64::to_bits);
-        let times: Vec<f64> = (0..3 * RECENT_LEN).map(|k| 0.5 + 97.3 * k as f64).collect();
+        let times: Vec<f64> = (0..3 * recent::KEPT)
+            .map(|k| 0.5 + 97.3 * k as f64)
+            .collect();
         for round in 0..3 {
             for (k, &t) in times.iter().enumerate() {
                 let t_again = times[k.saturating_sub(round)];

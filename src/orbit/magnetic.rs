@@ -228,8 +228,16 @@ impl GeomagneticField {
         {
             return b;
         }
-        let (r_hat, radius) = orbit.direction(t);
-        self.field_eci(t, &r_hat, radius)
+        // Kind 2: the dipole, 3: the harmonics, each at this epoch along this orbit.
+        let kind = match self.model {
+            FieldModel::Dipole => 2,
+            FieldModel::Igrf { .. } => 3,
+        };
+        let key = [kind, orbit.id(), self.epoch_unix_ns as u64, t.to_bits()];
+        super::recent::kept(key, || {
+            let (r_hat, radius) = orbit.direction(t);
+            self.field_eci(t, &r_hat, radius)
+        })
     }
 
     /// The model in words, for summaries and logs.
@@ -272,5 +280,44 @@ mod tests {
         assert!((d.h11 - (4545.5 - 2.5 * 21.5)).abs() < 1e-9);
         let mid = Dipole::igrf14(2022.5);
         assert!((mid.g11 - 0.5 * (-1451.37 - 1410.3)).abs() < 1e-9);
+    }
+
+    /// The values kept per thread answer each orbit and each model with its own field, bit
+    /// for bit: two orbits built from the same elements and a third, the dipole and the
+    /// harmonics, asked in turn at the same instants, each asked again after more instants
+    /// than are kept; equal orbits built apart are equal, with different identities.
+    #[test]
+    fn kept_values_answer_each_orbit_and_model_with_its_own_field() {
+        use crate::orbit::{CentralBody, Elements};
+        let orbit = |anomaly: f64| {
+            let elements = Elements::new(6878.137e3, 0.01, 1.7, 0.7, 0.2, anomaly);
+            Orbit::new(CentralBody::EARTH, elements, true).unwrap()
+        };
+        let (a, twin, b) = (orbit(0.3), orbit(0.3), orbit(2.0));
+        assert!(a == twin && a.id() != twin.id() && a != b);
+        let epoch = 1_803_945_600_000_000_000_i64;
+        let fields = [
+            GeomagneticField::new(epoch),
+            GeomagneticField::igrf(epoch, None),
+        ];
+        let direct = |field: &GeomagneticField, orbit: &Orbit, t: f64| {
+            let (r_hat, radius) = orbit.direction(t);
+            field.field_eci(t, &r_hat, radius).map(f64::to_bits)
+        };
+        for k in 0..3 * crate::orbit::recent::KEPT {
+            for t in [
+                0.5 + 61.7 * k as f64,
+                0.5 + 61.7 * k.saturating_sub(2) as f64,
+            ] {
+                for field in &fields {
+                    for orbit in [&a, &b, &twin, &a] {
+                        let value = field.field_on_orbit(orbit, t).map(f64::to_bits);
+                        assert_eq!(value, direct(field, orbit, t), "t = {t}");
+                    }
+                    assert_ne!(direct(field, &a, t), direct(field, &b, t));
+                }
+                assert_ne!(direct(&fields[0], &a, t), direct(&fields[1], &a, t));
+            }
+        }
     }
 }

@@ -32,6 +32,7 @@ pub mod field_table;
 pub mod igrf;
 pub mod kepler;
 pub mod magnetic;
+pub mod recent;
 
 pub use body::CentralBody;
 pub use earth::{earth_rotation_angle, gmst_iau82};
@@ -101,8 +102,11 @@ impl Lvlh {
 /// The fields are private because the constructor caches derived quantities (mean motion,
 /// rates, perifocal axes); read them with [`Orbit::body`], [`Orbit::elements`] and
 /// [`Orbit::j2_secular`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Orbit {
+    /// This orbit's identity ([`recent::next_id`]; a clone keeps it), for the field values
+    /// kept per thread; not part of its equality.
+    id: u64,
     body: CentralBody,
     elements: Elements,
     j2_secular: bool,
@@ -138,7 +142,29 @@ struct Phase {
     axes: [Vector3<f64>; 3],
 }
 
+impl PartialEq for Orbit {
+    /// Equal elements about the same body with the same secular rates: the same motion
+    /// (whatever the identities).
+    fn eq(&self, other: &Orbit) -> bool {
+        let Orbit {
+            id: _,
+            body,
+            elements,
+            j2_secular,
+            ..
+        } = self;
+        // The rest is derived from these three.
+        *body == other.body && *elements == other.elements && *j2_secular == other.j2_secular
+    }
+}
+
 impl Orbit {
+    /// This orbit's identity: a number no other orbit built in the process has (its clones
+    /// share it).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
     /// An orbit from validated elements (see [`Elements::validate`]).
     pub fn new(body: CentralBody, elements: Elements, j2_secular: bool) -> Result<Orbit, String> {
         elements.validate(&body)?;
@@ -171,6 +197,7 @@ impl Orbit {
         let e0 = (eta * sn).atan2(e + cn);
         let m0 = kepler::mean_from_eccentric(e0, e);
         Ok(Orbit {
+            id: recent::next_id(),
             body,
             elements,
             j2_secular,
