@@ -354,6 +354,13 @@ impl Effector for HysteresisRod {
         dx[WORK] =
             scratch[0] * hub.omega[0] + scratch[1] * hub.omega[1] + scratch[2] * hub.omega[2];
     }
+    fn has_switching(&self) -> bool {
+        true
+    }
+    /// dH/dt: where it changes sign the slope changes branch, and dB/dt kinks.
+    fn switching(&self, hub: &HubState, _x: &[f64]) -> Option<f64> {
+        Some(self.seen(hub).h_rate)
+    }
     fn energy(&self, _hub: &HubState, x: &[f64]) -> EnergyAccount {
         EnergyAccount {
             work: x[WORK],

@@ -324,6 +324,18 @@ pub trait Effector: Any + Debug + Send + Sync {
     /// controller samples the hub state here (its tick) and holds its command. Also called
     /// once at t = 0 by [`Spacecraft::initial_state`]: a controller's first tick.
     fn at_breakpoint(&self, _hub: &HubState, _x: &mut [f64]) {}
+    /// Whether it has a switching function ([`Effector::switching`]).
+    fn has_switching(&self) -> bool {
+        false
+    }
+    /// Its switching function at the hub state and its states `x`: where it changes sign, its
+    /// right-hand side kinks (a slope that changes branch with the sign of a rate). The run
+    /// loop of an adaptive method extrapolates it from each step to where it will cross zero,
+    /// and ends the next step there if it falls inside, so that the step does not straddle
+    /// the kink. `None` for none (the default).
+    fn switching(&self, _hub: &HubState, _x: &[f64]) -> Option<f64> {
+        None
+    }
     /// For its share of a discrete linear loop on the body rate (hub torque −G ω sampled
     /// every `period` s and held): its gain matrix G (N m s, body axes) and `period`. Read by
     /// the failure diagnosis, which blames a sampled loop whose G·Δt overcorrects the inertia.
@@ -836,6 +848,23 @@ impl Spacecraft {
             .iter()
             .filter_map(|e| e.next_breakpoint(t))
             .min_by(f64::total_cmp)
+    }
+
+    /// Whether an effector has a switching function ([`Effector::has_switching`]).
+    pub fn has_switching(&self) -> bool {
+        self.effectors.iter().any(|e| e.has_switching())
+    }
+
+    /// Each effector's switching function at `(t, y)` into `out` (one per effector,
+    /// [`Effector::switching`]; 0 where it has none).
+    pub fn switching_values(&self, t: f64, y: &[f64], out: &mut [f64]) {
+        let hub = self.hub_state(t, y);
+        for (k, e) in self.effectors.iter().enumerate() {
+            let off = self.offsets[k];
+            out[k] = e
+                .switching(&hub, &y[off..off + self.lens[k]])
+                .unwrap_or(0.0);
+        }
     }
 
     /// Updates every effector's held states in `y` at the breakpoint `t` (s), where each

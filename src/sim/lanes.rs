@@ -214,6 +214,15 @@ pub fn lane_form(sim: &Simulation) -> Result<(LaneForm, LaneSettings), String> {
     if let Some(refusal) = sim.method.refusal(sc, sim.duration) {
         return Err(format!("{} refuses it ({refusal})", sim.method.name()));
     }
+    if let Some(e) = sc.effectors().iter().find(|e| e.has_switching()) {
+        // The scalar loop forecasts its kinks and stops there; the lanes do not.
+        return Err(format!(
+            "its effector `{}` ({}) has a switching function, whose kinks the lanes do not \
+             stop at",
+            e.name(),
+            e.kind()
+        ));
+    }
     if sc.effectors().len() == hinged_rods::RODS {
         if let Some(reason) = breakpoints_without_lane_form(sc) {
             return Err(reason);

@@ -30,7 +30,7 @@ pub use support::{
     support,
 };
 
-use crate::integrate::{OdeSystem, Stats, Stepper};
+use crate::integrate::{OdeSystem, Stats, Stepper, same_instant};
 use crate::model::{Invariants, Observation, Spacecraft};
 use crate::timefmt::seconds;
 use monitor::Monitor;
@@ -456,6 +456,7 @@ fn drive<M: Stepper>(
 ) -> std::io::Result<Outcome> {
     let sc = &sim.spacecraft;
     let t_end = sim.duration;
+    let mut kinks = KinkForecast::for_run(sim, stepper.t(), stepper.y());
     let (mut monitor, mut status) = Monitor::start(sim, stepper.y(), sink, interior_checks)?;
     let mut scratch = vec![0.0; sc.dim()];
     let mut last_poll = Instant::now();
@@ -483,11 +484,15 @@ fn drive<M: Stepper>(
             monitor.restarted();
         }
         let stop = next_stop(sc, t0, t_end);
+        let stop = kinks.as_ref().map_or(stop, |k| k.stop(t0, stop));
         if let Err(e) = stepper.step(sc, stop) {
             status = Some(Status::Failed {
                 diagnosis: diagnose(&e.to_string(), t0, stepper.y(), sim),
             });
             break;
+        }
+        if let Some(k) = kinks.as_mut() {
+            k.after_step(sc, t0, stepper.t(), stepper.y());
         }
         // A breakpoint reached: restart before the next step (this step's samples and events
         // are read from its dense output first, on the breakpoint's near side).
@@ -499,6 +504,66 @@ fn drive<M: Stepper>(
         p(outcome.final_observation.t);
     }
     Ok(outcome)
+}
+
+/// Where the effectors' right-hand sides will kink next ([`Effector::switching`] crossing
+/// zero), extrapolated from each step's two ends by the secant through them, so that an
+/// adaptive method ends a step there instead of straddling the kink (a step across a kink
+/// fails its error test until it is short). A forecast is only a stop: the right-hand side
+/// stays the effectors' own, so a kink forecast a little early or late, or not at all, is met
+/// by the error control as before.
+///
+/// [`Effector::switching`]: crate::model::Effector::switching
+struct KinkForecast {
+    /// Each effector's switching function at the start of the coming step.
+    last: Vec<f64>,
+    /// The same at the end of the step just taken.
+    now: Vec<f64>,
+    /// The first kink forecast after the last step (s), if any.
+    next: Option<f64>,
+}
+
+impl KinkForecast {
+    /// For a run of `sim` at `(t, y)` if its scene has switching functions and its method is
+    /// adaptive (a fixed-step method keeps its grid).
+    fn for_run(sim: &Simulation, t: f64, y: &[f64]) -> Option<Self> {
+        let sc = &sim.spacecraft;
+        if !sc.has_switching() || !matches!(sim.method, Method::Dopri5(_) | Method::Dop853(_)) {
+            return None;
+        }
+        let mut last = vec![0.0; sc.effectors().len()];
+        sc.switching_values(t, y, &mut last);
+        Some(KinkForecast {
+            now: last.clone(),
+            last,
+            next: None,
+        })
+    }
+
+    /// Where a step from `t0` (s) that would end at `stop` ends: at the forecast kink if it
+    /// falls strictly between (and is not the same instant as either).
+    fn stop(&self, t0: f64, stop: f64) -> f64 {
+        match self.next {
+            Some(t) if t > t0 && t < stop && !same_instant(t0, t) && !same_instant(t, stop) => t,
+            _ => stop,
+        }
+    }
+
+    /// After the step from `t0` to `t1` (s), ending at `y`: the next forecast.
+    fn after_step(&mut self, sc: &crate::model::Spacecraft, t0: f64, t1: f64, y: &[f64]) {
+        sc.switching_values(t1, y, &mut self.now);
+        self.next = None;
+        for (&g0, &g1) in self.last.iter().zip(&self.now) {
+            // Moving towards zero without reaching it: where the secant crosses it.
+            if g0 * g1 > 0.0 && g1.abs() < g0.abs() {
+                let t = t1 + g1 * (t1 - t0) / (g0 - g1);
+                if t.is_finite() {
+                    self.next = Some(self.next.map_or(t, |n: f64| n.min(t)));
+                }
+            }
+        }
+        std::mem::swap(&mut self.last, &mut self.now);
+    }
 }
 
 /// The diagnosis when a step's deferred dense output comes out non-finite.
