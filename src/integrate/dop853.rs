@@ -564,7 +564,7 @@ pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
     }
     // Stages 1, 6–16, in the order of the rows D4…D7. One pass for the four rows, so each
     // stage value is loaded once.
-    let ks: [&[L]; 12] = [0, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15].map(|j| &k[j].as_ref()[..n]);
+    let ks = dense_stage_values(k, n);
     let (c4, c5, c6, c7) = (
         &mut c4.as_mut()[..n],
         &mut c5.as_mut()[..n],
@@ -586,6 +586,71 @@ pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
         c6[i] = h * s6;
         c7[i] = h * s7;
     }
+}
+
+/// The components of `components` of the dense output at `t` (s) strictly inside the
+/// accepted step `h` (s) from `(t_prev, y)` to `(t_now, y_new)` with stages `k`, into `out`
+/// (the others are left as they are): [`dense_coefficients`] and then [`dense_interior`], bit
+/// for bit, one component at a time (for one time inside a step, the coefficients are not
+/// worth forming and storing).
+#[inline(always)]
+pub(crate) fn dense_point<L: Lane, K: AsRef<[L]>>(
+    h: L,
+    y: &[L],
+    y_new: &[L],
+    k: &[K; 16],
+    (t, t_prev, t_now): (L, L, L),
+    components: &[bool],
+    out: &mut [L],
+) {
+    let n = y.len();
+    let (y_new, components, out) = (&y_new[..n], &components[..n], &mut out[..n]);
+    let (k1, k13) = (&k[0].as_ref()[..n], &k[12].as_ref()[..n]);
+    let ks = dense_stage_values(k, n);
+    let c = L::splat;
+    let s = (t - t_prev) / (t_now - t_prev);
+    let s1 = c(1.0) - s;
+    for i in 0..n {
+        if !components[i] {
+            continue;
+        }
+        let dy = y_new[i] - y[i];
+        let bspl = h * k1[i] - dy;
+        let c3 = dy - h * k13[i] - bspl;
+        let (mut s4, mut s5, mut s6, mut s7) = (c(0.0), c(0.0), c(0.0), c(0.0));
+        for j in 0..12 {
+            let v = ks[j][i];
+            s4 += c(D4[j]) * v;
+            s5 += c(D5[j]) * v;
+            s6 += c(D6[j]) * v;
+            s7 += c(D7[j]) * v;
+        }
+        let (c4, c5, c6, c7) = (h * s4, h * s5, h * s6, h * s7);
+        let conpar = c4 + s * (c5 + s1 * (c6 + s * c7));
+        out[i] = y[i] + s * (dy + s1 * (bspl + s * (c3 + s1 * conpar)));
+    }
+}
+
+/// Stages 1 and 6–16 of `k` (their first `n` components), in the order of the rows D4…D7.
+/// Written out: an array's `map` and its closure may be left out of line, where a lane
+/// type's operations lose the engine's instruction set.
+#[inline(always)]
+fn dense_stage_values<L, K: AsRef<[L]>>(k: &[K; 16], n: usize) -> [&[L]; 12] {
+    let s = |j: usize| &k[j].as_ref()[..n];
+    [
+        s(0),
+        s(5),
+        s(6),
+        s(7),
+        s(8),
+        s(9),
+        s(10),
+        s(11),
+        s(12),
+        s(13),
+        s(14),
+        s(15),
+    ]
 }
 
 /// The dense output at `t` (s) strictly inside the accepted step from `t_prev` to `t_now`,

@@ -94,6 +94,10 @@ pub trait LaneSystem<L: Lane, const DIM: usize, R> {
     /// The observation at `y`, as `Spacecraft::observe` forms it (the nutation angle's
     /// arctangent by [`super::elementary::half_plane_atan2`], the scalar path's too).
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L>;
+    /// The state components the observation's nutation angle reads: the others may hold
+    /// anything when only the nutation angle is read (a grid observation of
+    /// [`GridObservation::NutationAngle`] interpolates only these).
+    const NUTATION_READS: [bool; DIM] = [true; DIM];
 }
 
 /// The integration settings every run of a campaign shares (as the scalar `Dopri5::new` and
@@ -295,6 +299,23 @@ pub(crate) fn assert_lanes_are_the_spacecrafts<R: LaneRun<DIM>, const DIM: usize
             "rhs, {case}, lane {i}"
         );
         assert_lane_is_observation(&o, i, &sc.observe(0.0, &states[i]));
+    }
+    // The components the nutation angle does not read (`NUTATION_READS`) may hold anything:
+    // with them not a number, its bits are the same.
+    let reads = <R::System<F64x4> as LaneSystem<F64x4, DIM, R>>::NUTATION_READS;
+    let mut masked = y;
+    for (m, &read) in masked.iter_mut().zip(&reads) {
+        if !read {
+            *m = F64x4::splat(f64::NAN);
+        }
+    }
+    let angle = system.observe(&masked).nutation_angle;
+    for i in 0..spacecraft.len() {
+        assert_eq!(
+            angle.lane(i).to_bits(),
+            o.nutation_angle.lane(i).to_bits(),
+            "nutation angle from the components it reads, {case}, lane {i}"
+        );
     }
 }
 
@@ -1255,10 +1276,19 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
             // The scalar monitor prepares the dense output of a step with a grid time inside.
             self.prepare_dense(due);
             let mut y = [zero; DIM];
-            // Formed and read at once (the coefficients the observation does not need are
-            // dropped by the compiler).
-            let dense = self.method.dense(self.h_step, &self.y_start, &self.y_new);
-            M::dense_at(&dense, t_k, self.t_prev, self.t, &mut y);
+            // Where only the nutation angle is read, only the components it reads.
+            let components = match self.grid {
+                GridObservation::NutationAngle => R::System::<L>::NUTATION_READS,
+                GridObservation::Full => [true; DIM],
+            };
+            self.method.dense_point(
+                self.h_step,
+                &self.y_start,
+                &self.y_new,
+                (t_k, self.t_prev, self.t),
+                &components,
+                &mut y,
+            );
             let observation = self.system.observe(&y);
             // The later grid times k / rate inside the step (k an integer: exact sums).
             let next = self.next_sample + one;

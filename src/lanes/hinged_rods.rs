@@ -332,6 +332,19 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
         solved
     }
 
+    /// ω and the rods' angles and rates: not the attitude, nor the energy the dampers
+    /// dissipated.
+    const NUTATION_READS: [bool; DIM] = {
+        let mut reads = [false; DIM];
+        let mut i = 0;
+        while i < DIM {
+            let rod_state = (i as isize - HUB_STATES as isize).rem_euclid(ROD_STATES as isize);
+            reads[i] = i < 3 || (i >= HUB_STATES && rod_state < 4);
+            i += 1;
+        }
+        reads
+    };
+
     /// The observation at state `y`, with the operations (and their order) of
     /// `observe::invariants` on this scene: the hub's I ω and ½ ω·Iω, the group's momentum
     /// summed from zero rod by rod and added to the hub's, each rod's energies summed from

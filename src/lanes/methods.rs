@@ -116,6 +116,28 @@ pub(crate) trait LaneMethod<L: Lane, const DIM: usize> {
     /// The dense output at `t` (s) strictly inside the step from `t_prev` to `t_now` whose
     /// coefficients are `dense`, into `out`.
     fn dense_at(dense: &Self::Dense, t: L, t_prev: L, t_now: L, out: &mut [L; DIM]);
+    /// The components of `components` of the dense output at `t` (s) strictly inside the last
+    /// attempted step `h` (s) from `(t_prev, y)` to `(t_now, y_new)` (its dense stages
+    /// evaluated), into `out` (the others are left as they are): [`LaneMethod::dense`] and
+    /// then [`LaneMethod::dense_at`], bit for bit, without keeping the coefficients.
+    #[inline(always)]
+    fn dense_point(
+        &self,
+        h: L,
+        y: &[L; DIM],
+        y_new: &[L; DIM],
+        (t, t_prev, t_now): (L, L, L),
+        components: &[bool; DIM],
+        out: &mut [L; DIM],
+    ) {
+        let mut all = *out;
+        Self::dense_at(&self.dense(h, y, y_new), t, t_prev, t_now, &mut all);
+        for ((o, a), &wanted) in out.iter_mut().zip(all).zip(components) {
+            if wanted {
+                *o = a;
+            }
+        }
+    }
     /// Lane `i`'s dense output over the last attempted step `h` (s) from `y` to `y_new`
     /// (that lane's values), as the scalar method forms it.
     fn interpolant(
@@ -439,6 +461,19 @@ impl<L: Lane, const DIM: usize> LaneMethod<L, DIM> for Dop853Lanes<L, DIM> {
     #[inline(always)]
     fn dense_at(dense: &Self::Dense, t: L, t_prev: L, t_now: L, out: &mut [L; DIM]) {
         dop853::dense_interior(t, t_prev, t_now, dense, out);
+    }
+
+    #[inline(always)]
+    fn dense_point(
+        &self,
+        h: L,
+        y: &[L; DIM],
+        y_new: &[L; DIM],
+        times: (L, L, L),
+        components: &[bool; DIM],
+        out: &mut [L; DIM],
+    ) {
+        dop853::dense_point(h, y, y_new, &self.0.step_stages(), times, components, out);
     }
 
     fn interpolant(

@@ -47,6 +47,12 @@ pub const BLOCK_RUNS: u64 = 4096;
 /// (see `Prepared::longest_first`).
 pub const ORDERED_RUNS_PER_THREAD: usize = 32;
 
+/// Most runs integrated together in one lockstep of lanes (a chunk), and the most runs of a
+/// block ordered by their expected cost when the campaign runs in lanes, whatever the thread
+/// count: a chunk's lanes idle from the moment its last run starts until its longest
+/// remaining run ends, so its runs are best many and longest first.
+pub const LANE_CHUNK_RUNS: usize = 128;
+
 /// Worker threads allowed per logical core: a campaign asking for more threads than
 /// [`max_threads`] gets that many. Threads beyond the cores only add contention (rayon's own
 /// default is one per logical core), and a pool of 10⁵ threads takes minutes to start, during
@@ -789,26 +795,41 @@ impl Prepared {
             let block = start..(start + BLOCK_RUNS).min(range.end);
             start = block.end;
             let n = (block.end - block.start) as usize;
-            let (order, built) = self.longest_first(block.clone(), &pool, interrupt);
+            let lanes = matches!(self.integration, Integration::Lanes(_));
+            let (order, built) = self.longest_first(block.clone(), &pool, lanes, interrupt);
             // A list schedule: each thread takes the next run of `order` as it finishes one,
             // so that the longest runs start first and the short ones fill in at the end (a
             // run's row does not depend on when or where it runs).
             let next = AtomicUsize::new(0);
             let slots: Vec<Mutex<Option<Row>>> = (0..n).map(|_| Mutex::new(None)).collect();
             // Lanes take a chunk of runs at a time: enough to keep the lanes full (a lane that
-            // finishes takes the chunk's next run), few enough to share the block out.
+            // finishes takes the chunk's next run), few enough to share the block out among
+            // threads (on one thread, as many as a chunk holds). The runs are dealt to the
+            // chunks in turn, so that each chunk holds long and short runs, longest first
+            // where the order is a prediction: its lanes idle at its end only while its
+            // shortest runs finish.
             let width = match self.integration {
                 Integration::Lanes(engine) => engine.width(),
                 Integration::Scalar(_) => 1,
             };
-            let chunk = (n / (4 * threads.max(1))).clamp(2 * width.max(4), 128);
+            let chunk = if threads <= 1 {
+                n.min(LANE_CHUNK_RUNS)
+            } else {
+                (n / (4 * threads)).clamp(2 * width.max(4), LANE_CHUNK_RUNS)
+            };
+            let chunks = if lanes {
+                dealt(&order, n.div_ceil(chunk.max(1)))
+            } else {
+                Vec::new()
+            };
+            let next_chunk = AtomicUsize::new(0);
             pool.broadcast(|_| {
                 while let Integration::Lanes(engine) = self.integration {
-                    let k = next.fetch_add(chunk, Ordering::Relaxed);
-                    if k >= n || interrupt.load(Ordering::Relaxed) {
+                    let c = next_chunk.fetch_add(1, Ordering::Relaxed);
+                    if c >= chunks.len() || interrupt.load(Ordering::Relaxed) {
                         break;
                     }
-                    let js = &order[k..(k + chunk).min(n)];
+                    let js = &chunks[c];
                     let runs = js
                         .iter()
                         .map(|&j| {
@@ -826,7 +847,8 @@ impl Prepared {
                         }
                     }
                 }
-                loop {
+                // One run at a time on the scalar path.
+                while let Integration::Scalar(_) = self.integration {
                     let k = next.fetch_add(1, Ordering::Relaxed);
                     if k >= n || interrupt.load(Ordering::Relaxed) {
                         break;
@@ -863,15 +885,19 @@ impl Prepared {
     /// bounds an explicit method's step, times the duration), computed on `pool`. Runs
     /// whose draw is invalid keep their index order after the others; so do all runs once
     /// `interrupt` is set. In index order, without a prediction: the averaged method's runs
-    /// (whose cost is their slow steps), one thread, and more than [`ORDERED_RUNS_PER_THREAD`]
-    /// runs per thread, where the last runs' imbalance is small against the whole, and the
-    /// built runs would have to be held for the whole block.
+    /// (whose cost is their slow steps), one thread on the scalar path, and more than
+    /// [`ORDERED_RUNS_PER_THREAD`] runs per thread (in `lanes`, more than that or
+    /// [`LANE_CHUNK_RUNS`], whichever is larger), where the last runs' imbalance is small
+    /// against the whole, and the built runs would have to be held for the whole block. In
+    /// lanes the order matters on one thread too: a chunk's lanes idle while its last runs
+    /// finish.
     /// Returns the order and, when it predicted, each run as it built it (taken by the runs,
     /// so that none is built twice).
     fn longest_first(
         &self,
         range: Range<u64>,
         pool: &rayon::ThreadPool,
+        lanes: bool,
         interrupt: &AtomicBool,
     ) -> (Vec<usize>, Vec<Mutex<Option<Built>>>) {
         let n = (range.end - range.start) as usize;
@@ -880,7 +906,12 @@ impl Prepared {
             crate::sim::Method::Averaged(_)
         );
         let threads = pool.current_num_threads();
-        if averaged || n < 2 || threads < 2 || n > ORDERED_RUNS_PER_THREAD * threads {
+        let most = if lanes {
+            (ORDERED_RUNS_PER_THREAD * threads).max(LANE_CHUNK_RUNS)
+        } else {
+            ORDERED_RUNS_PER_THREAD * threads
+        };
+        if averaged || n < 2 || (threads < 2 && !lanes) || n > most {
             return ((0..n).collect(), Vec::new());
         }
         let predicted: Vec<(f64, Option<Built>)> = pool.install(|| {
@@ -993,6 +1024,15 @@ pub fn load_with_method(
 pub fn shard_range(runs: u64, k: u64, n: u64) -> Range<u64> {
     let at = |j: u64| ((u128::from(runs) * u128::from(j)) / u128::from(n)) as u64;
     at(k - 1)..at(k)
+}
+
+/// `order` dealt into `chunks` chunks in turn: chunk c holds `order[c]`, `order[c + chunks]`,
+/// …, in that order.
+fn dealt(order: &[usize], chunks: usize) -> Vec<Vec<usize>> {
+    let chunks = chunks.clamp(1, order.len().max(1));
+    (0..chunks)
+        .map(|c| order.iter().skip(c).step_by(chunks).copied().collect())
+        .collect()
 }
 
 /// Tracks the largest nutation angle seen (rad) at output samples and events.

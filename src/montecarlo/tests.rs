@@ -274,6 +274,35 @@ fn shards_partition_the_runs() {
 }
 
 #[test]
+fn dealt_chunks_hold_every_run_once_longest_first() {
+    assert_eq!(
+        dealt(&[9, 4, 7, 0, 2, 8, 1], 3),
+        vec![vec![9, 0, 1], vec![4, 2], vec![7, 8]]
+    );
+    for n in [0usize, 1, 5, 64, 130] {
+        let order: Vec<usize> = (0..n).rev().collect();
+        for chunks in [0usize, 1, 2, 7, 200] {
+            let dealt = dealt(&order, chunks);
+            let sizes: Vec<usize> = dealt.iter().map(Vec::len).collect();
+            let (smallest, largest) = (sizes.iter().min(), sizes.iter().max());
+            assert!(
+                largest.zip(smallest).is_none_or(|(l, s)| l - s <= 1),
+                "{sizes:?}"
+            );
+            // Each chunk keeps the order's order.
+            assert!(dealt.iter().all(|c| c.windows(2).all(|w| w[0] > w[1])));
+            let mut all: Vec<usize> = dealt.concat();
+            all.sort_unstable();
+            assert_eq!(
+                all,
+                (0..n).collect::<Vec<_>>(),
+                "{n} runs in {chunks} chunks"
+            );
+        }
+    }
+}
+
+#[test]
 fn erfc_matches_tabulated_values() {
     // Abramowitz and Stegun, Table 7.1: erf(0.5) = 0.5204998778, erf(1) = 0.8427007929,
     // erf(2) = 0.9953222650.
@@ -314,7 +343,7 @@ fn the_runs_expected_longest_start_first_and_do_cost_the_most() {
         .build()
         .unwrap();
     let never = AtomicBool::new(false);
-    let (order, _) = p.longest_first(0..12, &pool, &never);
+    let (order, _) = p.longest_first(0..12, &pool, false, &never);
     let mut sorted = order.clone();
     sorted.sort_unstable();
     assert_eq!(
@@ -345,13 +374,25 @@ fn the_runs_expected_longest_start_first_and_do_cost_the_most() {
         .build()
         .unwrap();
     assert_eq!(
-        p.longest_first(0..12, &one, &never).0,
+        p.longest_first(0..12, &one, false, &never).0,
         (0..12).collect::<Vec<_>>()
     );
     let many = ORDERED_RUNS_PER_THREAD * 2 + 1;
     assert_eq!(
-        p.longest_first(0..many as u64, &pool, &never).0,
+        p.longest_first(0..many as u64, &pool, false, &never).0,
         (0..many).collect::<Vec<_>>()
+    );
+    // In lanes, one thread orders too (a chunk's lanes idle while its last runs finish), and
+    // up to a chunk of runs.
+    assert_eq!(p.longest_first(0..12, &one, true, &never).0, order);
+    assert_ne!(
+        p.longest_first(0..many as u64, &one, true, &never).0,
+        (0..many).collect::<Vec<_>>()
+    );
+    let more = LANE_CHUNK_RUNS.max(ORDERED_RUNS_PER_THREAD * 2) + 1;
+    assert_eq!(
+        p.longest_first(0..more as u64, &pool, true, &never).0,
+        (0..more).collect::<Vec<_>>()
     );
 }
 
