@@ -1,16 +1,21 @@
 //! One flap–lag hinged rod's closed form (docs/effectors.md, "Closed forms"), written once over
 //! [`Lane`]: at `f64` for each rod of a scene's group ([`super::rod_lanes::RodLanes`], the
 //! scalar path), and over runs side by side for the campaigns' hinged-rods class
-//! ([`crate::lanes::hinged_rods`]). Each operation is the one nalgebra does for
-//! `Vector3<f64>`, in its order ([`crate::lanes::linalg`]), so the group keeps the bits it had
-//! when it was written with nalgebra, and a run in the lanes has the scalar path's bits.
+//! ([`crate::lanes::hinged_rods`]), so a run in the lanes has the scalar path's bits. The
+//! direction ([`RodConstants::direction`]) and the coupling ([`RodConstants::coupling`]) take
+//! their dot and cross products and their sums of two products as fused multiply–adds where
+//! `FMA` ([`crate::lanes::linalg::mul_add`]): about half their arithmetic instructions, each
+//! rounded once; the rest of the momentum is nalgebra's operations for `Vector3<f64>` in its
+//! order ([`crate::lanes::linalg`]). Both paths fuse where the processor has AVX2 and FMA
+//! ([`crate::cpu::avx2_available`]) and neither does elsewhere, where the bits are those of
+//! the same operations unfused (nalgebra's order).
 //!
 //! Notation (body axes): h the hinge point, ê₀ the rest direction, n̂ the hinge axis,
 //! b̂ = n̂ × ê₀; the lag circle c = cos θ_l ê₀ + sin θ_l b̂ and the rod's direction
 //! ê = cos θ_f c + sin θ_f n̂; m₁ = m L/2, m₂ = m L²/3, μ = m₁²/m₂.
 
 use crate::lanes::Lane;
-use crate::lanes::linalg::{add, cross, dot, scale, sub};
+use crate::lanes::linalg::{add, axpby, cross, cross_fma, dot, dot_fma, mul_add, scale, sub};
 
 /// Entries of the rows W per rod: two rows of 7, W_k = [g_k, Cᵀ_k] / M_kk.
 pub const ROWS: usize = 14;
@@ -101,10 +106,17 @@ pub struct RodMomentum<L> {
 /// (p₂ × j) / M_kk], with p₂ = m₁ h + m₂ ê and F_s the rod's inertial force per unit of m₂
 /// (written out, without loops or closures, for the AVX-512 lanes).
 #[inline(always)]
-fn row<L: Lane>(j: [L; 3], inv: L, q_k: L, m1: L, p2: [L; 3], force_s: [L; 3]) -> [L; 7] {
-    let torque = cross(p2, j);
+fn row<L: Lane, const FMA: bool>(
+    j: [L; 3],
+    inv: L,
+    q_k: L,
+    m1: L,
+    p2: [L; 3],
+    force_s: [L; 3],
+) -> [L; 7] {
+    let torque = cross_fma::<L, FMA>(p2, j);
     [
-        (q_k - dot(j, force_s)) * inv,
+        (q_k - dot_fma::<L, FMA>(j, force_s)) * inv,
         m1 * j[0] * inv,
         m1 * j[1] * inv,
         m1 * j[2] * inv,
@@ -118,15 +130,16 @@ impl<L: Lane> RodConstants<L> {
     /// ê and its derivatives from `[sin θ_f, cos θ_f, sin θ_l, cos θ_l]`, as
     /// `HingedRod::direction_at`.
     #[inline(always)]
-    pub fn direction(&self, [sf, cf, sl, cl]: [L; 4]) -> Direction<L> {
-        let c = add(scale(cl, self.rest), scale(sl, self.binormal));
-        let c_prime = add(scale(-sl, self.rest), scale(cl, self.binormal));
-        let e = add(scale(cf, c), scale(sf, self.axis));
+    pub fn direction<const FMA: bool>(&self, [sf, cf, sl, cl]: [L; 4]) -> Direction<L> {
+        let axpby = axpby::<L, FMA>;
+        let c = axpby(cl, self.rest, sl, self.binormal);
+        let c_prime = axpby(-sl, self.rest, cl, self.binormal);
+        let e = axpby(cf, c, sf, self.axis);
         Direction {
             c,
             c_prime,
             e,
-            e_f: add(scale(-sf, c), scale(cf, self.axis)),
+            e_f: axpby(-sf, c, cf, self.axis),
             e_l: scale(cf, c_prime),
         }
     }
@@ -135,7 +148,13 @@ impl<L: Lane> RodConstants<L> {
     /// sines and cosines (as [`RodConstants::direction`] takes them), the hub's rate ω
     /// (rad/s) and |ω|² (nalgebra's `norm_squared`).
     #[inline(always)]
-    pub fn coupling(&self, angles: [L; 4], sines: [L; 4], omega: [L; 3], w2: L) -> RodCoupling<L> {
+    pub fn coupling<const FMA: bool>(
+        &self,
+        angles: [L; 4],
+        sines: [L; 4],
+        omega: [L; 3],
+        w2: L,
+    ) -> RodCoupling<L> {
         let [f, l, df, dl] = angles;
         let [sf, cf, ..] = sines;
         let (h, m1, m2, mu) = (self.hinge, self.m1, self.m2, self.mu);
@@ -146,7 +165,7 @@ impl<L: Lane> RodConstants<L> {
             e,
             e_f,
             e_l,
-        } = self.direction(sines);
+        } = self.direction::<FMA>(sines);
         // κ = Σ ∂²ê u u: −cos θ_f θ̇_l² c − 2 sin θ_f θ̇_f θ̇_l c′ − θ̇_f² ê.
         let kappa = sub(
             sub(scale(-cf * dl * dl, c), scale(two * sf * df * dl, c_prime)),
@@ -155,31 +174,32 @@ impl<L: Lane> RodConstants<L> {
         let cos2 = norm_squared(e_l);
         let q_flap = -self.stiffness[0] * f - self.damping[0] * df;
         let q_lag = -self.stiffness[1] * l - self.damping[1] * dl;
-        let joint = add(scale(q_flap, e_f), scale(q_lag / cos2, e_l));
-        let e_rate = add(scale(df, e_f), scale(dl, e_l));
+        let (dot, cross) = (dot_fma::<L, FMA>, cross_fma::<L, FMA>);
+        let axpby = axpby::<L, FMA>;
+        let joint = axpby(q_flap, e_f, q_lag / cos2, e_l);
+        let e_rate = axpby(df, e_f, dl, e_l);
         let relative = add(scale(two, cross(omega, e_rate)), kappa);
         let omega_e = dot(omega, e);
-        let lambda = omega_e * omega_e - w2 + dot(e, relative);
-        let a_h = sub(scale(dot(omega, h), omega), scale(w2, h));
+        let lambda = mul_add::<L, FMA>(omega_e, omega_e, -w2) + dot(e, relative);
+        let a_h = axpby(dot(omega, h), omega, -w2, h);
         let hinge_force = add(
-            add(
-                scale(self.hinge_mass, a_h),
-                scale(mu * dot(e, a_h) + m1 * lambda, e),
+            axpby(
+                self.hinge_mass,
+                a_h,
+                mul_add::<L, FMA>(mu, dot(e, a_h), m1 * lambda),
+                e,
             ),
             scale(self.m1_over_m2, joint),
         );
         let hinge_moment = add(cross(h, hinge_force), cross(e, joint));
         let he = cross(h, e);
         // The rows W (L = 1).
-        let p2 = add(scale(m1, h), scale(m2, e));
-        let force_s = add(
-            sub(scale(dot(omega, p2), omega), scale(w2, p2)),
-            scale(m2, relative),
-        );
+        let p2 = axpby(m1, h, m2, e);
+        let force_s = add(axpby(dot(omega, p2), omega, -w2, p2), scale(m2, relative));
         // The flap's inertia is m₂, whose reciprocal is a constant (the same bits as dividing
         // here); the lag's, m₂ cos² θ_f.
-        let flap = row(e_f, self.inverse_m2, q_flap, m1, p2, force_s);
-        let lag = row(e_l, L::splat(1.0) / (m2 * cos2), q_lag, m1, p2, force_s);
+        let flap = row::<L, FMA>(e_f, self.inverse_m2, q_flap, m1, p2, force_s);
+        let lag = row::<L, FMA>(e_l, L::splat(1.0) / (m2 * cos2), q_lag, m1, p2, force_s);
         let rows = [
             flap[0], flap[1], flap[2], flap[3], flap[4], flap[5], flap[6], lag[0], lag[1], lag[2],
             lag[3], lag[4], lag[5], lag[6],
@@ -197,8 +217,13 @@ impl<L: Lane> RodConstants<L> {
     /// with their sines and cosines, the hub turning at ω (rad/s): the velocity along the rod
     /// is v(s) = v_h + s v_ê, v_h = ω × h, v_ê = ω × ê + θ̇_f ∂ê/∂θ_f + θ̇_l ∂ê/∂θ_l.
     #[inline(always)]
-    pub fn momentum(&self, angles: [L; 4], sines: [L; 4], omega: [L; 3]) -> RodMomentum<L> {
-        let Direction { e, e_f, e_l, .. } = self.direction(sines);
+    pub fn momentum<const FMA: bool>(
+        &self,
+        angles: [L; 4],
+        sines: [L; 4],
+        omega: [L; 3],
+    ) -> RodMomentum<L> {
+        let Direction { e, e_f, e_l, .. } = self.direction::<FMA>(sines);
         let (m, m1, m2, h) = (self.hinge_mass + self.mu, self.m1, self.m2, self.hinge);
         let (half, two) = (L::splat(0.5), L::splat(2.0));
         let v_h = cross(omega, h);

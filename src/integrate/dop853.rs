@@ -903,7 +903,7 @@ impl Dop853 {
 
 /// [`solution_and_errors`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn solution_and_errors_avx2(
     arguments: (f64, f64, f64),
     y: &[f64],

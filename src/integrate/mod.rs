@@ -283,7 +283,7 @@ pub(crate) fn combine_on<const M: usize>(
 
 /// [`combine`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn combine_avx2<const M: usize>(
     out: &mut [f64],
     base: &[f64],

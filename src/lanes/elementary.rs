@@ -355,7 +355,7 @@ mod tests {
         every_lane_is_the_scalar_result::<crate::lanes::F64x4>();
         #[cfg(target_arch = "x86_64")]
         {
-            #[target_feature(enable = "avx2")]
+            #[target_feature(enable = "avx2,fma")]
             fn check() {
                 every_lane_is_the_scalar_result::<crate::lanes::F64x4>();
             }

@@ -587,7 +587,7 @@ unsafe fn prepare_dense_avx512<
 
 /// [`Lanes::prepare_dense`] compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 unsafe fn prepare_dense_avx2<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize>(
     lanes: &mut Lanes<L, R, M, DIM>,
     needed: L::Mask,
@@ -779,11 +779,11 @@ fn run_method<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     }
 }
 
-/// [`lockstep`] at four lanes, compiled for AVX2 (everything below is inlined into it). No
-/// `mul_add` is written and FMA is not enabled, so nothing is fused: the bits are the scalar
-/// path's.
+/// [`lockstep`] at four lanes, compiled for AVX2 and FMA (everything below is inlined into
+/// it). Only a written `mul_add` is fused, as the scalar path fuses it: the bits are the
+/// scalar path's.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 unsafe fn lockstep_avx2<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
     runs: &[R],
     settings: &LaneSettings,
@@ -793,8 +793,9 @@ unsafe fn lockstep_avx2<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
 }
 
 /// [`lockstep`] at eight lanes, compiled for AVX-512F so that the lane type's intrinsics
-/// inline into it: one 512-bit instruction per element-wise operation. Nothing is fused (no
-/// fused intrinsic is called, and Rust contracts nothing): the bits are the scalar path's.
+/// inline into it: one 512-bit instruction per element-wise operation. Only a written
+/// `mul_add` is fused (`vfmadd`, as the scalar path fuses it; Rust contracts nothing else):
+/// the bits are the scalar path's.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
 unsafe fn lockstep_avx512<R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
@@ -825,7 +826,7 @@ fn rhs_baseline<L: Lane, R: LaneRun<DIM>, const DIM: usize>(
 
 /// [`LaneSystem::rhs`] out of line at four lanes, compiled for AVX2.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 #[inline(never)]
 unsafe fn rhs_avx2<R: LaneRun<DIM>, const DIM: usize>(
     system: &R::System<F64x4>,

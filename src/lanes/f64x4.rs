@@ -1,10 +1,11 @@
 //! [`F64x4`]: four f64 lanes, and [`M64x4`], their mask.
 //!
 //! Plain arrays with element-wise operations (`std::array::from_fn` over the four lanes): compiled inside a function with
-//! `#[target_feature(enable = "avx2")]` (everything here is `#[inline(always)]`), LLVM
+//! `#[target_feature(enable = "avx2,fma")]` (everything here is `#[inline(always)]`), LLVM
 //! turns each loop into one 256-bit instruction (vaddpd, vmulpd, vdivpd, vsqrtpd, vcmppd, a
-//! blend); compiled for baseline x86-64 it uses two 128-bit SSE2 instructions instead. The
-//! results are the same either way: each lane is rounded as the f64 operation.
+//! blend, and `vfmadd` for [`Lane::mul_add`]); compiled for baseline x86-64 it uses two 128-bit
+//! SSE2 instructions instead (and the C library's `fma` for `mul_add`). The results are the
+//! same either way: each lane is rounded as the f64 operation.
 
 use super::{Lane, LaneMask};
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
@@ -162,6 +163,16 @@ impl Lane for F64x4 {
         map(self, f64::sqrt)
     }
     #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        let (x, a, b) = (self.0, a.0, b.0);
+        F64x4([
+            x[0].mul_add(a[0], b[0]),
+            x[1].mul_add(a[1], b[1]),
+            x[2].mul_add(a[2], b[2]),
+            x[3].mul_add(a[3], b[3]),
+        ])
+    }
+    #[inline(always)]
     fn max(self, o: Self) -> Self {
         zip(self, o, f64::max)
     }
@@ -238,7 +249,7 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn every_lane_is_the_f64_operation_in_avx2_registers() {
-        #[target_feature(enable = "avx2")]
+        #[target_feature(enable = "avx2,fma")]
         fn check() {
             every_lane_is_the_f64_operation::<F64x4>();
             powers_of_two_are_exact::<F64x4>();

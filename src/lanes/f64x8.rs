@@ -8,7 +8,7 @@
 //!
 //! Each operation rounds every lane as the f64 operation it names (`vaddpd`, `vsubpd`,
 //! `vmulpd`, `vdivpd`, `vsqrtpd` are IEEE 754 binary64 operations, round to nearest, and
-//! nothing is fused); `max`, `min`, `clamp` and `powf` go lane by lane through the f64 ones,
+//! `vfmadd` rounds once, as `f64::mul_add`; nothing else is fused); `max`, `min`, `clamp` and `powf` go lane by lane through the f64 ones,
 //! so their treatment of NaN and signed zeros is the scalar path's too (they run once a step).
 //!
 //! **Where it may run.** The operations execute AVX-512F instructions whatever function they
@@ -23,11 +23,11 @@ use std::arch::x86_64::{
     __m512d, __mmask8, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP_GT_OQ, _CMP_LE_OQ, _CMP_LT_OQ,
     _MM_FROUND_NO_EXC, _MM_FROUND_TO_ZERO, _MM_MANT_NORM_1_2, _MM_MANT_SIGN_SRC, _mm256_and_si256,
     _mm256_set1_epi32, _mm512_add_pd, _mm512_and_epi64, _mm512_castpd_si512, _mm512_castsi512_pd,
-    _mm512_cmp_pd_mask, _mm512_cvtsd_f64, _mm512_cvttpd_epi32, _mm512_div_pd, _mm512_getexp_pd,
-    _mm512_getmant_pd, _mm512_i32gather_pd, _mm512_loadu_pd, _mm512_mask_blend_pd,
-    _mm512_mask_mov_pd, _mm512_mul_pd, _mm512_permutexvar_pd, _mm512_roundscale_pd,
-    _mm512_scalef_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd, _mm512_storeu_pd,
-    _mm512_sub_pd, _mm512_xor_epi64,
+    _mm512_cmp_pd_mask, _mm512_cvtsd_f64, _mm512_cvttpd_epi32, _mm512_div_pd, _mm512_fmadd_pd,
+    _mm512_getexp_pd, _mm512_getmant_pd, _mm512_i32gather_pd, _mm512_loadu_pd,
+    _mm512_mask_blend_pd, _mm512_mask_mov_pd, _mm512_mul_pd, _mm512_permutexvar_pd,
+    _mm512_roundscale_pd, _mm512_scalef_pd, _mm512_set1_epi64, _mm512_set1_pd, _mm512_sqrt_pd,
+    _mm512_storeu_pd, _mm512_sub_pd, _mm512_xor_epi64,
 };
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
@@ -273,6 +273,12 @@ impl Lane for F64x8 {
     fn sqrt(self) -> Self {
         // SAFETY: AVX-512F: see the module.
         F64x8(unsafe { _mm512_sqrt_pd(self.0) })
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        // SAFETY: AVX-512F (whose fused multiply–add rounds once, as `f64::mul_add`): see
+        // the module.
+        F64x8(unsafe { _mm512_fmadd_pd(self.0, a.0, b.0) })
     }
     #[inline(always)]
     fn max(self, o: Self) -> Self {

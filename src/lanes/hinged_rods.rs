@@ -147,6 +147,9 @@ pub struct RodsLanes<L: Lane> {
     /// The lower triangle of the rods' constant part.
     constant_mass: [[L; 6]; 6],
     spin_axis: [L; 3],
+    /// Whether the rods' closed form fuses its multiply–adds, as the scalar group does on
+    /// this processor ([`crate::cpu::avx2_available`]).
+    fma: bool,
 }
 
 impl<L: Lane> RodsLanes<L> {
@@ -164,98 +167,17 @@ impl<L: Lane> RodsLanes<L> {
 impl<L: Lane> RodsLanes<L> {
     /// Rod `r`'s closed form at state `y`, the hub turning at `w` (rad/s) with |ω|² `w2`.
     #[inline(always)]
-    fn rod_coupling(&self, y: &[L], r: usize, w: [L; 3], w2: L) -> RodCoupling<L> {
+    fn rod_coupling<const FMA: bool>(&self, y: &[L], r: usize, w: [L; 3], w2: L) -> RodCoupling<L> {
         let (angles, sines) = Self::rod_angles(y, r);
-        self.rods[r].coupling(angles, sines, w, w2)
+        self.rods[r].coupling::<FMA>(angles, sines, w, w2)
     }
 }
 
-/// The right-hand side writes the four rods out.
-const _: () = assert!(RODS == 4);
-
-impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
-    #[inline(always)]
-    fn idle() -> Self {
-        let z = L::splat(0.0);
-        let rod = RodConstants {
-            hinge: [z; 3],
-            rest: [z; 3],
-            axis: [z; 3],
-            binormal: [z; 3],
-            m1: z,
-            m2: z,
-            inverse_m2: z,
-            m1_over_m2: z,
-            mu: z,
-            hinge_mass: z,
-            stiffness: [z; 2],
-            damping: [z; 2],
-        };
-        RodsLanes {
-            hub_inertia: [[z; 3]; 3],
-            hub_mass: z,
-            rods: [rod; RODS],
-            hub_matrix: [[z; 6]; 6],
-            constant_mass: [[z; 6]; 6],
-            spin_axis: [z; 3],
-        }
-    }
-
-    #[inline(always)]
-    fn load(&mut self, i: usize, run: &RodsRun) {
-        let set = |x: &mut L, v: f64| *x = x.with_lane(i, v);
-        let set3 = |x: &mut [L; 3], v: &[f64; 3]| {
-            for (x, v) in x.iter_mut().zip(v) {
-                *x = x.with_lane(i, *v);
-            }
-        };
-        set(&mut self.hub_mass, run.hub_mass);
-        for j in 0..3 {
-            set(&mut self.spin_axis[j], run.spin_axis[j]);
-            for c in 0..3 {
-                set(&mut self.hub_inertia[c][j], run.hub_inertia[(j, c)]);
-            }
-        }
-        // The hub's own matrix as the scalar coupling starts it: m on the translational
-        // diagonal, the inertia in the rotational block.
-        let mut hub = Matrix6::<f64>::zeros();
-        for k in 0..3 {
-            hub[(k, k)] = run.hub_mass;
-        }
-        hub.fixed_view_mut::<3, 3>(3, 3).copy_from(&run.hub_inertia);
-        for c in 0..6 {
-            for r in 0..6 {
-                set(&mut self.hub_matrix[c][r], hub[(r, c)]);
-                set(&mut self.constant_mass[c][r], run.constant_mass[(r, c)]);
-            }
-        }
-        for (lanes, rod) in self.rods.iter_mut().zip(&run.rods) {
-            set3(&mut lanes.hinge, &rod.hinge);
-            set3(&mut lanes.rest, &rod.rest);
-            set3(&mut lanes.axis, &rod.axis);
-            set3(&mut lanes.binormal, &rod.binormal);
-            set(&mut lanes.m1, rod.m1);
-            set(&mut lanes.m2, rod.m2);
-            set(&mut lanes.inverse_m2, rod.inverse_m2);
-            set(&mut lanes.m1_over_m2, rod.m1_over_m2);
-            set(&mut lanes.mu, rod.mu);
-            set(&mut lanes.hinge_mass, rod.hinge_mass);
-            for k in 0..2 {
-                set(&mut lanes.stiffness[k], rod.stiffness[k]);
-                set(&mut lanes.damping[k], rod.damping[k]);
-            }
-        }
-    }
-
-    /// The right-hand side, as `Spacecraft::rhs` takes it for this scene: the hub's equations
-    /// M z = f with M = the hub's own matrix plus the group's sum (its constant part, then
-    /// μ v vᵀ rod by rod) and f = [0; −ω × Iω] minus the rods' summed hinge forces and
-    /// moments, solved by the Schur complement; then each rod's θ̈ = W_g − W_C z and its
-    /// dampers' power. Returns the lanes the Schur solve took (the scalar path falls back to
-    /// LU elsewhere).
+impl<L: Lane> RodsLanes<L> {
+    /// [`LaneSystem::rhs`], with the rods' closed form fused where `FMA`.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // the triangle's loops index several arrays
-    fn rhs(&self, y: &[L], dy: &mut [L]) -> L::Mask {
+    fn rhs_with<const FMA: bool>(&self, y: &[L], dy: &mut [L]) -> L::Mask {
         let (y, dy) = (&y[..DIM], &mut dy[..DIM]);
         let zero = L::splat(0.0);
         let w = [y[0], y[1], y[2]];
@@ -264,10 +186,10 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
         // may leave out of line, where the AVX-512 lanes' operations become calls (and
         // rather than filling a zeroed array, which cost a memset and a copy per call).
         let mut rods = [
-            self.rod_coupling(y, 0, w, w2),
-            self.rod_coupling(y, 1, w, w2),
-            self.rod_coupling(y, 2, w, w2),
-            self.rod_coupling(y, 3, w, w2),
+            self.rod_coupling::<FMA>(y, 0, w, w2),
+            self.rod_coupling::<FMA>(y, 1, w, w2),
+            self.rod_coupling::<FMA>(y, 2, w, w2),
+            self.rod_coupling::<FMA>(y, 3, w, w2),
         ];
         // The force: the gyroscopic term, less the rods' sums (rod 0 first).
         let w_cross_iw = cross(w, mat_vec(&self.hub_inertia, w));
@@ -331,27 +253,12 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
         dy[3..7].copy_from_slice(&q_dot);
         solved
     }
+}
 
-    /// ω and the rods' angles and rates: not the attitude, nor the energy the dampers
-    /// dissipated.
-    const NUTATION_READS: [bool; DIM] = {
-        let mut reads = [false; DIM];
-        let mut i = 0;
-        while i < DIM {
-            let rod_state = (i as isize - HUB_STATES as isize).rem_euclid(ROD_STATES as isize);
-            reads[i] = i < 3 || (i >= HUB_STATES && rod_state < 4);
-            i += 1;
-        }
-        reads
-    };
-
-    /// The observation at state `y`, with the operations (and their order) of
-    /// `observe::invariants` on this scene: the hub's I ω and ½ ω·Iω, the group's momentum
-    /// summed from zero rod by rod and added to the hub's, each rod's energies summed from
-    /// zero, and the hub's translation removed (the system's linear momentum is zero); then
-    /// the attitude, |H| and the nutation angle ([`LaneObservation::of_hub`]).
+impl<L: Lane> RodsLanes<L> {
+    /// [`LaneSystem::observe`], with the rods' directions fused where `FMA`.
     #[inline(always)]
-    fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
+    fn observe_with<const FMA: bool>(&self, y: &[L; DIM]) -> LaneObservation<L> {
         let zero = L::splat(0.0);
         let w = [y[0], y[1], y[2]];
         let iw = mat_vec(&self.hub_inertia, w);
@@ -361,7 +268,7 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
         let (mut elastic, mut dissipated, mut power) = (zero, zero, zero);
         for (r, rod) in self.rods.iter().enumerate() {
             let (angles, sines) = Self::rod_angles(y, r);
-            let m = rod.momentum(angles, sines, w);
+            let m = rod.momentum::<FMA>(angles, sines, w);
             mass += m.mass;
             first = add(first, m.first_moment);
             linear = add(linear, m.linear);
@@ -390,6 +297,128 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
             [kinetic, elastic, dissipated, power, zero + zero],
             self.spin_axis,
         )
+    }
+}
+
+/// The right-hand side writes the four rods out.
+const _: () = assert!(RODS == 4);
+
+impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
+    #[inline(always)]
+    fn idle() -> Self {
+        let z = L::splat(0.0);
+        let rod = RodConstants {
+            hinge: [z; 3],
+            rest: [z; 3],
+            axis: [z; 3],
+            binormal: [z; 3],
+            m1: z,
+            m2: z,
+            inverse_m2: z,
+            m1_over_m2: z,
+            mu: z,
+            hinge_mass: z,
+            stiffness: [z; 2],
+            damping: [z; 2],
+        };
+        RodsLanes {
+            hub_inertia: [[z; 3]; 3],
+            hub_mass: z,
+            rods: [rod; RODS],
+            hub_matrix: [[z; 6]; 6],
+            constant_mass: [[z; 6]; 6],
+            spin_axis: [z; 3],
+            fma: crate::cpu::avx2_available(),
+        }
+    }
+
+    #[inline(always)]
+    fn load(&mut self, i: usize, run: &RodsRun) {
+        let set = |x: &mut L, v: f64| *x = x.with_lane(i, v);
+        let set3 = |x: &mut [L; 3], v: &[f64; 3]| {
+            for (x, v) in x.iter_mut().zip(v) {
+                *x = x.with_lane(i, *v);
+            }
+        };
+        set(&mut self.hub_mass, run.hub_mass);
+        for j in 0..3 {
+            set(&mut self.spin_axis[j], run.spin_axis[j]);
+            for c in 0..3 {
+                set(&mut self.hub_inertia[c][j], run.hub_inertia[(j, c)]);
+            }
+        }
+        // The hub's own matrix as the scalar coupling starts it: m on the translational
+        // diagonal, the inertia in the rotational block.
+        let mut hub = Matrix6::<f64>::zeros();
+        for k in 0..3 {
+            hub[(k, k)] = run.hub_mass;
+        }
+        hub.fixed_view_mut::<3, 3>(3, 3).copy_from(&run.hub_inertia);
+        for c in 0..6 {
+            for r in 0..6 {
+                set(&mut self.hub_matrix[c][r], hub[(r, c)]);
+                set(&mut self.constant_mass[c][r], run.constant_mass[(r, c)]);
+            }
+        }
+        for (lanes, rod) in self.rods.iter_mut().zip(&run.rods) {
+            set3(&mut lanes.hinge, &rod.hinge);
+            set3(&mut lanes.rest, &rod.rest);
+            set3(&mut lanes.axis, &rod.axis);
+            set3(&mut lanes.binormal, &rod.binormal);
+            set(&mut lanes.m1, rod.m1);
+            set(&mut lanes.m2, rod.m2);
+            set(&mut lanes.inverse_m2, rod.inverse_m2);
+            set(&mut lanes.m1_over_m2, rod.m1_over_m2);
+            set(&mut lanes.mu, rod.mu);
+            set(&mut lanes.hinge_mass, rod.hinge_mass);
+            for k in 0..2 {
+                set(&mut lanes.stiffness[k], rod.stiffness[k]);
+                set(&mut lanes.damping[k], rod.damping[k]);
+            }
+        }
+    }
+
+    /// The right-hand side, as `Spacecraft::rhs` takes it for this scene: the hub's equations
+    /// M z = f with M = the hub's own matrix plus the group's sum (its constant part, then
+    /// μ v vᵀ rod by rod) and f = [0; −ω × Iω] minus the rods' summed hinge forces and
+    /// moments, solved by the Schur complement; then each rod's θ̈ = W_g − W_C z and its
+    /// dampers' power. Returns the lanes the Schur solve took (the scalar path falls back to
+    /// LU elsewhere).
+    #[inline(always)]
+    fn rhs(&self, y: &[L], dy: &mut [L]) -> L::Mask {
+        // Eight lanes run only where AVX-512F is, and with it AVX2 and FMA: one copy.
+        if L::WIDTH == 8 || self.fma {
+            self.rhs_with::<true>(y, dy)
+        } else {
+            self.rhs_with::<false>(y, dy)
+        }
+    }
+
+    /// ω and the rods' angles and rates: not the attitude, nor the energy the dampers
+    /// dissipated.
+    const NUTATION_READS: [bool; DIM] = {
+        let mut reads = [false; DIM];
+        let mut i = 0;
+        while i < DIM {
+            let rod_state = (i as isize - HUB_STATES as isize).rem_euclid(ROD_STATES as isize);
+            reads[i] = i < 3 || (i >= HUB_STATES && rod_state < 4);
+            i += 1;
+        }
+        reads
+    };
+
+    /// The observation at state `y`, with the operations (and their order) of
+    /// `observe::invariants` on this scene: the hub's I ω and ½ ω·Iω, the group's momentum
+    /// summed from zero rod by rod and added to the hub's, each rod's energies summed from
+    /// zero, and the hub's translation removed (the system's linear momentum is zero); then
+    /// the attitude, |H| and the nutation angle ([`LaneObservation::of_hub`]).
+    #[inline(always)]
+    fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
+        if L::WIDTH == 8 || self.fma {
+            self.observe_with::<true>(y)
+        } else {
+            self.observe_with::<false>(y)
+        }
     }
 }
 
@@ -446,6 +475,59 @@ mod tests {
     /// `Spacecraft`'s bit for bit, at states spread over ±1.4 rad and ±30 rad/s for the rods
     /// and over ±80 rad/s for the hub, a rod at rest with signed zeros included, and a flap of
     /// exactly 90° (whose lag has no inertia) poisons the same way.
+    /// The rods' closed form fused and unfused (the scalar group's on a processor with and
+    /// without FMA) is the same mathematics: the right-hand sides agree to rounding, and
+    /// fusing does change bits (so the fused path is the one the other test checks).
+    #[test]
+    fn fused_and_unfused_right_hand_sides_agree_to_rounding() {
+        let scenes: Vec<Spacecraft> = (0..4).map(spacecraft).collect();
+        let mut lanes = RodsLanes::<F64x4>::idle();
+        let omega = Vector3::new(0.3, -1.1, 78.5);
+        let q = UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1);
+        let mut differing = 0;
+        for sample in 0..20 {
+            let states: Vec<[f64; DIM]> = (0..4)
+                .map(|k| {
+                    let mut y =
+                        <[f64; DIM]>::try_from(scenes[k].initial_state(&omega, &q).as_slice())
+                            .expect("the class's layout");
+                    for r in 0..RODS {
+                        let b = (sample * 4 + k) as f64 + 5.0 * r as f64;
+                        let x = HUB_STATES + ROD_STATES * r;
+                        y[x..x + 4].copy_from_slice(&[
+                            1.2 * (0.7 * b).sin(),
+                            1.2 * (1.1 * b).cos(),
+                            20.0 * (1.3 * b).cos(),
+                            20.0 * (0.4 * b).sin(),
+                        ]);
+                    }
+                    y
+                })
+                .collect();
+            for (i, sc) in scenes.iter().enumerate() {
+                let run = RodsRun::new(sc, &states[i], 1.0, 0.0).expect("of the class");
+                lanes.load(i, &run);
+            }
+            let y: [F64x4; DIM] =
+                std::array::from_fn(|j| F64x4(std::array::from_fn(|i| states[i][j])));
+            let (mut fused, mut unfused) = ([F64x4::splat(0.0); DIM], [F64x4::splat(0.0); DIM]);
+            lanes.rhs_with::<true>(&y, &mut fused);
+            lanes.rhs_with::<false>(&y, &mut unfused);
+            for j in 0..DIM {
+                for i in 0..4 {
+                    let (a, b) = (fused[j].lane(i), unfused[j].lane(i));
+                    let scale = (0..DIM).map(|c| fused[c].lane(i).abs()).fold(0.0, f64::max);
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "sample {sample}, lane {i}, component {j}: {a} against {b}"
+                    );
+                    differing += usize::from(a.to_bits() != b.to_bits());
+                }
+            }
+        }
+        assert!(differing > 100, "{differing} components differ");
+    }
+
     #[test]
     fn the_lanes_right_hand_side_and_observation_are_the_spacecrafts() {
         let scenes: Vec<Spacecraft> = (0..4).map(spacecraft).collect();

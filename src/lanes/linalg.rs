@@ -15,6 +15,41 @@ pub fn dot<L: Lane>(a: [L; 3], b: [L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// `a·b + c`, rounded once ([`Lane::mul_add`]) where `FMA`, twice (the product, then the
+/// sum) otherwise.
+#[inline(always)]
+pub fn mul_add<L: Lane, const FMA: bool>(a: L, b: L, c: L) -> L {
+    if FMA { a.mul_add(b, c) } else { a * b + c }
+}
+
+/// `a · b` as `a₂b₂ + (a₁b₁ + a₀b₀)` by [`mul_add`]: without `FMA`, [`dot`]'s bits.
+#[inline(always)]
+pub fn dot_fma<L: Lane, const FMA: bool>(a: [L; 3], b: [L; 3]) -> L {
+    mul_add::<L, FMA>(a[2], b[2], mul_add::<L, FMA>(a[1], b[1], a[0] * b[0]))
+}
+
+/// `a × b`, each component `aᵢbⱼ − aⱼbᵢ` as `aᵢbⱼ + (−aⱼbᵢ)` by [`mul_add`]: without `FMA`,
+/// [`cross`]'s bits.
+#[inline(always)]
+pub fn cross_fma<L: Lane, const FMA: bool>(a: [L; 3], b: [L; 3]) -> [L; 3] {
+    [
+        mul_add::<L, FMA>(a[1], b[2], -(a[2] * b[1])),
+        mul_add::<L, FMA>(a[2], b[0], -(a[0] * b[2])),
+        mul_add::<L, FMA>(a[0], b[1], -(a[1] * b[0])),
+    ]
+}
+
+/// `s a + t b` as `s a + (t b)` by [`mul_add`]: without `FMA`, the bits of
+/// `add(scale(s, a), scale(t, b))`.
+#[inline(always)]
+pub fn axpby<L: Lane, const FMA: bool>(s: L, a: [L; 3], t: L, b: [L; 3]) -> [L; 3] {
+    [
+        mul_add::<L, FMA>(s, a[0], t * b[0]),
+        mul_add::<L, FMA>(s, a[1], t * b[1]),
+        mul_add::<L, FMA>(s, a[2], t * b[2]),
+    ]
+}
+
 /// `|a|` as nalgebra's `Vector3::norm` rounds it: `√(0 + ((x² + y²) + z²))`.
 #[inline(always)]
 pub fn norm<L: Lane>(a: [L; 3]) -> L {
@@ -158,6 +193,44 @@ mod tests {
         assert_eq!(dot(av, bv).to_bits(), a.dot(&b).to_bits());
         assert_eq!(cross(av, bv), <[f64; 3]>::from(a.cross(&b)));
         assert_eq!(mat_vec(&m.data.0, av), <[f64; 3]>::from(m * a));
+    }
+
+    /// Unfused, the multiply–add forms give the plain forms' bits (nalgebra's); fused, the
+    /// first product of each sum is not rounded, which keeps low bits that separate rounding
+    /// loses (values worked out by hand, below).
+    #[test]
+    fn multiply_add_forms_round_once_only_when_fused() {
+        let a = Vector3::new(0.3, -1.7e-3, 2.9);
+        let b = Vector3::new(-4.1, 0.77, 1.0 / 3.0);
+        let (av, bv) = ([a.x, a.y, a.z], [b.x, b.y, b.z]);
+        assert_eq!(dot_fma::<f64, false>(av, bv).to_bits(), a.dot(&b).to_bits());
+        assert_eq!(
+            cross_fma::<f64, false>(av, bv),
+            <[f64; 3]>::from(a.cross(&b))
+        );
+        let (s, t) = (0.7, -1.3);
+        assert_eq!(
+            axpby::<f64, false>(s, av, t, bv),
+            <[f64; 3]>::from(a * s + b * t)
+        );
+        // x = 1 + 2⁻³⁰, y = 1 + 2⁻²⁹: x·x − y·y with the exact products 1 + 2⁻²⁹ + 2⁻⁶⁰ and
+        // 1 + 2⁻²⁸ + 2⁻⁵⁸. Unfused, both low parts are lost: −2⁻²⁹. Fused, only the second
+        // product is rounded: −2⁻²⁹ + 2⁻⁶⁰. Likewise x·x − x·x is −2⁻⁶⁰ fused (the first
+        // product exact, the second rounded), 0 unfused; and x·x − y is 2⁻⁶⁰ fused.
+        let (x, y) = (1.0 + 2f64.powi(-30), 1.0 + 2f64.powi(-29));
+        let (p, q) = ([0.0, x, y], [0.0, y, x]);
+        let low = -(2f64.powi(-29));
+        assert_eq!(cross_fma::<f64, false>(p, q)[0], low);
+        assert_eq!(cross_fma::<f64, true>(p, q)[0], low + 2f64.powi(-60));
+        assert_eq!(
+            dot_fma::<f64, true>([x, 0.0, x], [x, 0.0, -x]),
+            -(2f64.powi(-60))
+        );
+        assert_eq!(dot_fma::<f64, false>([x, 0.0, x], [x, 0.0, -x]), 0.0);
+        assert_eq!(
+            axpby::<f64, true>(x, [x; 3], -y, [1.0; 3]),
+            [2f64.powi(-60); 3]
+        );
     }
 
     /// The lanes' Schur solve is the scalar hub solve's, bit for bit, on 2000 symmetric

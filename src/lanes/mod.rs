@@ -4,8 +4,9 @@
 //! A [`Lane`] is a value of one run (`f64`, width 1) or of W runs side by side, one per lane.
 //! Every operation acts lane by lane with the rounding of the f64 operation it names (IEEE 754
 //! binary64, round to nearest): no lane ever sees another, and no operation is contracted
-//! (Rust never fuses `a * b + c` into an FMA unless `mul_add` is written, and nothing here
-//! writes it), so a lane's result is bit for bit the result of the same code at `f64`.
+//! (Rust never fuses `a * b + c` into an FMA unless `mul_add` is written; where it is written,
+//! [`Lane::mul_add`], it rounds once, as `f64::mul_add` does at every width), so a lane's result
+//! is bit for bit the result of the same code at `f64`.
 //! Decisions that differ between lanes (accept or reject a step, a lane that has finished)
 //! are taken under a [`LaneMask`] and applied with [`Lane::select`].
 //!
@@ -121,6 +122,10 @@ pub trait Lane:
     fn abs(self) -> Self;
     /// √x per lane (correctly rounded, as `f64::sqrt`).
     fn sqrt(self) -> Self;
+    /// `self · a + b` per lane with one rounding, as `f64::mul_add` (the same bits on every
+    /// processor: an FMA instruction where the engine has one, the C library's `fma`
+    /// otherwise).
+    fn mul_add(self, a: Self, b: Self) -> Self;
     /// `f64::max` per lane (a NaN loses to a number).
     fn max(self, other: Self) -> Self;
     /// `f64::min` per lane (a NaN loses to a number).
@@ -219,6 +224,10 @@ impl Lane for f64 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        f64::mul_add(self, a, b)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
