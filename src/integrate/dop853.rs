@@ -571,16 +571,8 @@ pub(crate) fn dense_coefficients<L: Lane, K: AsRef<[L]>, C: AsMut<[L]>>(
         &mut c6.as_mut()[..n],
         &mut c7.as_mut()[..n],
     );
-    let c = L::splat;
     for i in 0..n {
-        let (mut s4, mut s5, mut s6, mut s7) = (c(0.0), c(0.0), c(0.0), c(0.0));
-        for j in 0..12 {
-            let v = ks[j][i];
-            s4 += c(D4[j]) * v;
-            s5 += c(D5[j]) * v;
-            s6 += c(D6[j]) * v;
-            s7 += c(D7[j]) * v;
-        }
+        let [s4, s5, s6, s7] = dense_sums(&ks, i);
         c4[i] = h * s4;
         c5[i] = h * s5;
         c6[i] = h * s6;
@@ -617,18 +609,28 @@ pub(crate) fn dense_point<L: Lane, K: AsRef<[L]>>(
         let dy = y_new[i] - y[i];
         let bspl = h * k1[i] - dy;
         let c3 = dy - h * k13[i] - bspl;
-        let (mut s4, mut s5, mut s6, mut s7) = (c(0.0), c(0.0), c(0.0), c(0.0));
-        for j in 0..12 {
-            let v = ks[j][i];
-            s4 += c(D4[j]) * v;
-            s5 += c(D5[j]) * v;
-            s6 += c(D6[j]) * v;
-            s7 += c(D7[j]) * v;
-        }
+        let [s4, s5, s6, s7] = dense_sums(&ks, i);
         let (c4, c5, c6, c7) = (h * s4, h * s5, h * s6, h * s7);
         let conpar = c4 + s * (c5 + s1 * (c6 + s * c7));
         out[i] = y[i] + s * (dy + s1 * (bspl + s * (c3 + s1 * conpar)));
     }
+}
+
+/// Component `i`'s sums Σⱼ D4ⱼ kⱼ … Σⱼ D7ⱼ kⱼ over the stages `ks`
+/// ([`dense_stage_values`]), each from zero in the rows' order (one pass, so each stage value
+/// is loaded once).
+#[inline(always)]
+fn dense_sums<L: Lane>(ks: &[&[L]; 12], i: usize) -> [L; 4] {
+    let c = L::splat;
+    let (mut s4, mut s5, mut s6, mut s7) = (c(0.0), c(0.0), c(0.0), c(0.0));
+    for j in 0..12 {
+        let v = ks[j][i];
+        s4 += c(D4[j]) * v;
+        s5 += c(D5[j]) * v;
+        s6 += c(D6[j]) * v;
+        s7 += c(D7[j]) * v;
+    }
+    [s4, s5, s6, s7]
 }
 
 /// Stages 1 and 6–16 of `k` (their first `n` components), in the order of the rows D4…D7.
