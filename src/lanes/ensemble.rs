@@ -1068,12 +1068,13 @@ impl<L: Lane, R: LaneRun<DIM>, M: LaneMethod<L, DIM>, const DIM: usize> Lanes<L,
     }
 
     /// Lane `i`'s last accepted step (of an observed integration), into `step`: the numbers
-    /// read at every step, the rest left in the lanes ([`LaneRest`]).
+    /// read at every step, the rest left in the lanes ([`LaneRest`]); `finite` holds the lanes
+    /// whose every state component is finite.
     #[inline(always)]
-    fn step_of(&self, i: usize, step: &mut LaneStep) {
+    fn step_of(&self, i: usize, finite: L::Mask, step: &mut LaneStep) {
         step.t_prev = read(&self.t_prev, i);
         step.t = read(&self.t, i);
-        step.finite = self.y.iter().all(|y| read(y, i).is_finite());
+        step.finite = finite.test(i);
         if let Some(e) = &self.end {
             step.end_nutation_angle = read(&e.nutation_angle, i);
             step.end_kinetic_energy = read(&e.kinetic_energy, i);
@@ -1555,11 +1556,16 @@ fn lockstep<L: Lane, R: LaneRun<DIM>, F: MethodFamily, const DIM: usize>(
         if lanes.running.any() {
             let accepted = lanes.attempt(observe.is_some());
             if let Some(observe) = observe.as_mut() {
+                // Which lanes' states are finite, for every lane at once.
+                let finite = lanes
+                    .y
+                    .iter()
+                    .fold(L::Mask::splat(true), |all, y| all & y.is_finite());
                 for (i, slot) in held.iter().enumerate() {
                     if let Some(index) = *slot
                         && accepted.test(i)
                     {
-                        lanes.step_of(i, &mut step);
+                        lanes.step_of(i, finite, &mut step);
                         let mut rest = LaneRest {
                             lanes: &mut lanes,
                             lane: i,

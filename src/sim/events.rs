@@ -105,6 +105,19 @@ impl<'a> Watch<'a> {
         }
     }
 
+    /// Whether [`Watch::advance`] over an interval ending at `b` with margins `ga`, `gb` would
+    /// neither fire nor change the watch: the margin keeps its side (no crossing to locate,
+    /// and `(ga > 0) == (gb > 0)` rules out NaN ends that could bracket one), and a condition
+    /// holding toward its `for:` duration does not complete it by `b`.
+    #[inline(always)]
+    pub fn unmoved(&self, ga: f64, gb: f64, b: f64) -> bool {
+        let completes = match self.phase {
+            Phase::Holding(since) => b >= since + self.condition.hold,
+            _ => false,
+        };
+        (ga > 0.0) == (gb > 0.0) && !completes
+    }
+
     /// The condition became true at `t`; the interval checked runs to `b` with margin `gb`.
     fn begin(&mut self, t: f64, b: f64, gb: f64) -> Option<Firing> {
         if self.condition.hold == 0.0 || (gb > 0.0 && b >= t + self.condition.hold) {
@@ -293,6 +306,63 @@ mod tests {
                 t: 1.0,
                 confirmed: 2.5
             }]
+        );
+    }
+
+    /// Wherever `unmoved` says an interval changes nothing, `advance` over it neither fires,
+    /// nor locates a crossing, nor changes the watch's phase; and the claim is made for the
+    /// common intervals (margins on one side, nothing due), in every phase.
+    #[test]
+    fn an_unmoved_watch_is_what_advance_leaves_unchanged() {
+        let conditions = [
+            below(0.0, false, 0.0),
+            below(0.0, true, 0.0),
+            below(0.0, false, 2.0),
+        ];
+        let margins = [-1.0, -0.0, 0.0, 1e-300, 1.0, f64::NAN, f64::INFINITY];
+        let (mut claimed, mut checked) = (0, 0);
+        let mut phases = Vec::new();
+        for c in &conditions {
+            // The phases: idle; holding since 0.5 (with `for:`); fired; done (with `once`).
+            let mut watches = vec![Watch::new(c, false)];
+            let mut w = Watch::new(c, false);
+            w.start(1.0);
+            watches.push(w);
+            for w in &mut watches.clone() {
+                w.advance(0.0, 1.0, -1.0, 1.0, |_| 0.5);
+                watches.push(w.clone());
+            }
+            for w in &watches {
+                for &ga in &margins {
+                    for &gb in &margins {
+                        for b in [1.0, 2.49, 2.5, 10.0] {
+                            checked += 1;
+                            if !w.unmoved(ga, gb, b) {
+                                continue;
+                            }
+                            claimed += 1;
+                            let mut after = w.clone();
+                            let fired = after.advance(b - 0.25, b, ga, gb, |_| {
+                                panic!("a crossing located in an unmoved interval")
+                            });
+                            assert_eq!(fired, None, "{w:?} over ({ga}, {gb}) to {b}");
+                            assert_eq!(after.phase, w.phase, "{w:?} over ({ga}, {gb}) to {b}");
+                        }
+                    }
+                }
+            }
+            phases.extend(watches.iter().map(|w| w.phase));
+            for w in &watches {
+                assert!(w.unmoved(-1.0, -1.0, 1.0) || matches!(w.phase, Phase::Holding(_)));
+                assert!(!w.unmoved(-1.0, 1.0, 1.0) && !w.unmoved(1.0, -1.0, 1.0));
+            }
+        }
+        assert!(claimed > checked / 4, "{claimed} of {checked}");
+        assert!(phases.contains(&Phase::Idle) && phases.contains(&Phase::Fired));
+        assert!(phases.contains(&Phase::Done), "{phases:?}");
+        assert!(
+            phases.iter().any(|p| matches!(p, Phase::Holding(_))),
+            "{phases:?}"
         );
     }
 

@@ -413,94 +413,108 @@ impl<'a> Monitor<'a> {
         // (event time, time known, condition, terminal)
         let mut found: Vec<(f64, f64, &Condition, bool)> = Vec::new();
         if !watches.is_empty() {
-            // Interior points only where a margin could cross and re-cross inside the step
-            // (`far_from_crossing`): elsewhere the step's ends decide, and the dense output
-            // is not needed.
-            let h = t1 - t0;
-            let mut near = false;
-            let n_watches = watches.len();
-            for (((watch, g_before), &ga), &gb) in watches
-                .iter()
-                .zip(margins_before.iter_mut())
-                .zip(prev_margins.iter())
-                .zip(end_margins.iter())
-            {
-                near |= watch.active() && !far_from_crossing(*g_before, ga, gb, *h_before, h);
-                *g_before = ga;
-            }
-            *h_before = h;
-            let checks = if near { interior_checks } else { 0 };
-            if checks > 0 && !stepper.prepare_interpolation(sc) {
-                return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
-            }
-            // The interior points (reused across steps: no allocation per step once they have
-            // grown); the points are t0, the interior ones, t1.
-            grid.clear();
-            grid_margins.clear();
-            for j in 1..=checks {
-                let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
-                stepper.interpolate(t, buf);
-                let o = observe_for_events(t, buf);
-                grid_margins.extend(watches.iter().map(|w| w.condition.margin(&o)));
-                grid.push(t);
-            }
-            let last = checks + 1;
-            let time_at = |p: usize| match p {
-                0 => t0,
-                p if p == last => t1,
-                p => grid[p - 1],
-            };
-            let margin_at = |p: usize, w: usize| match p {
-                0 => prev_margins[w],
-                p if p == last => end_margins[w],
-                p => grid_margins[(p - 1) * n_watches + w],
-            };
-            // A sign change is located on the dense output.
-            let bracketed = watches.iter().enumerate().any(|(k, w)| {
-                w.active()
-                    && (1..=last).any(|p| (margin_at(p - 1, k) > 0.0) != (margin_at(p, k) > 0.0))
-            });
-            if bracketed && !stepper.prepare_interpolation(sc) {
-                return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
-            }
-            for (k, watch) in watches.iter_mut().enumerate() {
-                if !watch.active() {
-                    continue;
+            'watching: {
+                // Interior points only where a margin could cross and re-cross inside the step
+                // (`far_from_crossing`): elsewhere the step's ends decide, and the dense output
+                // is not needed.
+                let h = t1 - t0;
+                let mut near = false;
+                // Whether, without interior points, every watch would come out of the step as it
+                // went in (the common step, far from every threshold): then the general pass
+                // below would change nothing but the margins' swap.
+                let mut unmoved = true;
+                let n_watches = watches.len();
+                for (((watch, g_before), &ga), &gb) in watches
+                    .iter()
+                    .zip(margins_before.iter_mut())
+                    .zip(prev_margins.iter())
+                    .zip(end_margins.iter())
+                {
+                    if watch.active() {
+                        near |= !far_from_crossing(*g_before, ga, gb, *h_before, h);
+                        unmoved &= watch.unmoved(ga, gb, t1);
+                    }
+                    *g_before = ga;
                 }
-                let c = watch.condition;
-                for p in 1..=last {
-                    let (a, b) = (time_at(p - 1), time_at(p));
-                    let (ga, gb) = (margin_at(p - 1, k), margin_at(p, k));
-                    let crossing = |up: bool| {
-                        let mut scratch = vec![0.0; n];
-                        let margin = |t: f64, y: &[f64]| c.margin(&observe_for_events(t, y));
-                        if up {
-                            locate(&*stepper, &margin, a, b, ga, gb, &mut scratch)
-                        } else {
-                            locate(
-                                &*stepper,
-                                &|t, y| -margin(t, y),
-                                a,
-                                b,
-                                -ga,
-                                -gb,
-                                &mut scratch,
-                            )
-                        }
-                    };
-                    if let Some(f) = watch.advance(a, b, ga, gb, crossing) {
-                        found.push((f.t, f.confirmed, c, watch.terminal));
-                        if watch.terminal || !watch.active() {
-                            break;
+                *h_before = h;
+                if !near && unmoved {
+                    std::mem::swap(prev_margins, end_margins);
+                    break 'watching;
+                }
+                let checks = if near { interior_checks } else { 0 };
+                if checks > 0 && !stepper.prepare_interpolation(sc) {
+                    return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
+                }
+                // The interior points (reused across steps: no allocation per step once they have
+                // grown); the points are t0, the interior ones, t1.
+                grid.clear();
+                grid_margins.clear();
+                for j in 1..=checks {
+                    let t = t0 + (t1 - t0) * j as f64 / (checks + 1) as f64;
+                    stepper.interpolate(t, buf);
+                    let o = observe_for_events(t, buf);
+                    grid_margins.extend(watches.iter().map(|w| w.condition.margin(&o)));
+                    grid.push(t);
+                }
+                let last = checks + 1;
+                let time_at = |p: usize| match p {
+                    0 => t0,
+                    p if p == last => t1,
+                    p => grid[p - 1],
+                };
+                let margin_at = |p: usize, w: usize| match p {
+                    0 => prev_margins[w],
+                    p if p == last => end_margins[w],
+                    p => grid_margins[(p - 1) * n_watches + w],
+                };
+                // A sign change is located on the dense output.
+                let bracketed = watches.iter().enumerate().any(|(k, w)| {
+                    w.active()
+                        && (1..=last)
+                            .any(|p| (margin_at(p - 1, k) > 0.0) != (margin_at(p, k) > 0.0))
+                });
+                if bracketed && !stepper.prepare_interpolation(sc) {
+                    return Ok(Some(dense_failure(t0, t1, stepper.y(), sim)));
+                }
+                for (k, watch) in watches.iter_mut().enumerate() {
+                    if !watch.active() {
+                        continue;
+                    }
+                    let c = watch.condition;
+                    for p in 1..=last {
+                        let (a, b) = (time_at(p - 1), time_at(p));
+                        let (ga, gb) = (margin_at(p - 1, k), margin_at(p, k));
+                        let crossing = |up: bool| {
+                            let mut scratch = vec![0.0; n];
+                            let margin = |t: f64, y: &[f64]| c.margin(&observe_for_events(t, y));
+                            if up {
+                                locate(&*stepper, &margin, a, b, ga, gb, &mut scratch)
+                            } else {
+                                locate(
+                                    &*stepper,
+                                    &|t, y| -margin(t, y),
+                                    a,
+                                    b,
+                                    -ga,
+                                    -gb,
+                                    &mut scratch,
+                                )
+                            }
+                        };
+                        if let Some(f) = watch.advance(a, b, ga, gb, crossing) {
+                            found.push((f.t, f.confirmed, c, watch.terminal));
+                            if watch.terminal || !watch.active() {
+                                break;
+                            }
                         }
                     }
                 }
-            }
-            std::mem::swap(prev_margins, end_margins);
-            if !found.is_empty() {
-                found.sort_by(|a, b| a.1.total_cmp(&b.1));
-                if let Some(i) = found.iter().position(|f| f.3) {
-                    found.truncate(i + 1);
+                std::mem::swap(prev_margins, end_margins);
+                if !found.is_empty() {
+                    found.sort_by(|a, b| a.1.total_cmp(&b.1));
+                    if let Some(i) = found.iter().position(|f| f.3) {
+                        found.truncate(i + 1);
+                    }
                 }
             }
         }
