@@ -174,6 +174,14 @@ impl<L: Lane> RodsLanes<L> {
 }
 
 impl<L: Lane> RodsLanes<L> {
+    /// Whether the rods' closed form is fused: as the scalar group on this processor, and
+    /// always in eight lanes, which run only where AVX-512F is, and with it AVX2 and FMA (so
+    /// that engine compiles one copy).
+    #[inline(always)]
+    fn fuses(&self) -> bool {
+        L::WIDTH == 8 || self.fma
+    }
+
     /// [`LaneSystem::rhs`], with the rods' closed form fused where `FMA`.
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // the triangle's loops index several arrays
@@ -386,8 +394,7 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
     /// LU elsewhere).
     #[inline(always)]
     fn rhs(&self, y: &[L], dy: &mut [L]) -> L::Mask {
-        // Eight lanes run only where AVX-512F is, and with it AVX2 and FMA: one copy.
-        if L::WIDTH == 8 || self.fma {
+        if self.fuses() {
             self.rhs_with::<true>(y, dy)
         } else {
             self.rhs_with::<false>(y, dy)
@@ -414,7 +421,7 @@ impl<L: Lane> LaneSystem<L, DIM, RodsRun> for RodsLanes<L> {
     /// the attitude, |H| and the nutation angle ([`LaneObservation::of_hub`]).
     #[inline(always)]
     fn observe(&self, y: &[L; DIM]) -> LaneObservation<L> {
-        if L::WIDTH == 8 || self.fma {
+        if self.fuses() {
             self.observe_with::<true>(y)
         } else {
             self.observe_with::<false>(y)
@@ -471,10 +478,6 @@ mod tests {
         sc
     }
 
-    /// The class's right-hand side and observation, in four lanes at once, are the scalar
-    /// `Spacecraft`'s bit for bit, at states spread over ±1.4 rad and ±30 rad/s for the rods
-    /// and over ±80 rad/s for the hub, a rod at rest with signed zeros included, and a flap of
-    /// exactly 90° (whose lag has no inertia) poisons the same way.
     /// The rods' closed form fused and unfused (the scalar group's on a processor with and
     /// without FMA) is the same mathematics: the right-hand sides agree to rounding, and
     /// fusing does change bits (so the fused path is the one the other test checks).
@@ -528,6 +531,10 @@ mod tests {
         assert!(differing > 100, "{differing} components differ");
     }
 
+    /// The class's right-hand side and observation, in four lanes at once, are the scalar
+    /// `Spacecraft`'s bit for bit, at states spread over ±1.4 rad and ±30 rad/s for the rods
+    /// and over ±80 rad/s for the hub, a rod at rest with signed zeros included, and a flap of
+    /// exactly 90° (whose lag has no inertia) poisons the same way.
     #[test]
     fn the_lanes_right_hand_side_and_observation_are_the_spacecrafts() {
         let scenes: Vec<Spacecraft> = (0..4).map(spacecraft).collect();
