@@ -284,7 +284,9 @@ impl Tally {
             .zip(&mut self.redraws)
         {
             if let Some(n) = r.values[j].filter(|x| x.is_finite() && *x >= 0.0) {
-                t.rejected += n as u64;
+                // A campaign's counts stay far below u64::MAX (MAX_RUNS runs of at most
+                // MAX_DRAWS_PER_RUN draws); a row from elsewhere saturates, never wraps.
+                t.rejected = t.rejected.saturating_add(n as u64);
                 t.runs += usize::from(n > 0.0);
                 // A run left invalid under `redraw` accepted no draw.
                 t.accepted += usize::from(!(invalid && Some(j) == run_column));
@@ -694,6 +696,40 @@ mod tests {
         );
         let [lo, hi] = wilson95(0, 10);
         assert!(lo == 0.0 && (hi - 0.2775).abs() < 5e-5, "{hi}");
+    }
+
+    #[test]
+    fn huge_redraw_counts_saturate_instead_of_overflowing() {
+        // Rows that no campaign writes (the fuzzer's): two counts of 1e300 draws each.
+        let spec = SummarySpec {
+            columns: vec!["redraws".into()],
+            events: Vec::new(),
+            probability_by: Vec::new(),
+            rank: RankRule {
+                column: 0,
+                name: "redraws".into(),
+                smaller_is_worse: true,
+                missing: f64::INFINITY,
+            },
+            invalid_draws: InvalidDrawSpec {
+                policy: "redraw",
+                run_column: Some(0),
+                dispersion_columns: Vec::new(),
+            },
+        };
+        let rows: Vec<Row> = (0..2)
+            .map(|run| Row {
+                run,
+                status: RunStatus::Complete,
+                message: String::new(),
+                values: vec![Some(1e300)],
+            })
+            .collect();
+        let mut tally = Tally::new(spec);
+        rows.iter().for_each(|r| tally.add(r));
+        let stats = statistics(&tally, &rows.as_slice()).unwrap();
+        let counted = &stats.invalid_draws.redrawn[0];
+        assert_eq!((counted.rejected, counted.runs), (u64::MAX, 2));
     }
 
     #[test]
