@@ -438,7 +438,6 @@ impl<'a> Monitor<'a> {
                 }
                 *h_before = h;
                 if !near && unmoved {
-                    std::mem::swap(prev_margins, end_margins);
                     break 'watching;
                 }
                 let checks = if near { interior_checks } else { 0 };
@@ -509,7 +508,6 @@ impl<'a> Monitor<'a> {
                         }
                     }
                 }
-                std::mem::swap(prev_margins, end_margins);
                 if !found.is_empty() {
                     found.sort_by(|a, b| a.1.total_cmp(&b.1));
                     if let Some(i) = found.iter().position(|f| f.3) {
@@ -517,6 +515,7 @@ impl<'a> Monitor<'a> {
                     }
                 }
             }
+            std::mem::swap(prev_margins, end_margins);
         }
         let stop_at = found.last().filter(|f| f.3).map(|f| f.1);
         let horizon = stop_at.unwrap_or(t1);
